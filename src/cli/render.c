@@ -1,0 +1,321 @@
+/* candela render SCENE [options]: load, render progressive passes until
+ * the sample or time budget is met (or Ctrl-C), write the images. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <omp.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli/args.h"
+#include "cli/commands.h"
+#include "core/log.h"
+#include "film/film.h"
+#include "film/image.h"
+#include "integrators/integrator.h"
+#include "scene/loader.h"
+
+#define MAX_OUT 8
+#define MAX_POINT_LIGHTS 64
+
+typedef struct render_args {
+    const char *scene, *integrator;
+    const char *out[MAX_OUT];
+    int nout;
+    long spp;
+    double time;
+    int width, height;
+    int has_lookat;
+    float lookat[9];
+    double fov;
+    long maxdepth, threads;
+    unsigned long long seed;
+    float lights[MAX_POINT_LIGHTS][6];
+    int nlights;
+    double exposure;
+} render_args;
+
+static void render_help(void)
+{
+    printf("usage: candela render SCENE [options]\n"
+           "\n"
+           "SCENE is a Wavefront OBJ file (materials from its MTL files).\n"
+           "\n"
+           "  -i, --integrator NAME   light transport method (default path)\n"
+           "  -o, --output FILE       .exr (32-bit float), .png (sRGB) or .pfm; repeatable\n"
+           "                          (default: SCENE's name with .exr, in the current directory)\n"
+           "      --spp N             samples per pixel, one per pass (default 64)\n"
+           "      --time SEC          render whole passes until SEC seconds are spent\n"
+           "      --res WxH           image size (default 512x512)\n"
+           "      --lookat ex,ey,ez,tx,ty,tz,ux,uy,uz   camera position, target, up\n"
+           "      --fov DEG           vertical field of view (default 40)\n"
+           "                          without --lookat the camera frames the scene's bounds\n"
+           "      --maxdepth N        maximum bounces (1 = direct light only; default 64)\n"
+           "      --seed N            random seed (default 1); same seed, same image\n"
+           "      --threads N         worker threads (default: all cores)\n"
+           "      --point-light x,y,z,r,g,b   add a point light of intensity (r,g,b) W/sr;\n"
+           "                          repeatable\n"
+           "      --exposure EV       PNG exposure in stops (default 0)\n"
+           "  -q, --quiet             no warnings, no progress bar\n"
+           "\n"
+           "Integrators:\n");
+    for (const cdl_integrator_vtbl *const *it = cdl_integrator_list(); *it; it++)
+        printf("  %-8s %s\n", (*it)->name, (*it)->summary);
+    printf("\nThe summary line gives wall time, samples per pixel and Mrays/s (all rays\n"
+           "traced divided by the render time). Ctrl-C writes the image so far (exit 130).\n");
+}
+
+/* Output files are checked before rendering so a typo costs no render. */
+static int check_output(const char *path, cdl_error *err)
+{
+    if (!cdl_image_has_ext(path, ".exr") && !cdl_image_has_ext(path, ".png") &&
+        !cdl_image_has_ext(path, ".pfm"))
+        return cdl_error_set(err, CDL_ERR_USAGE, "-o", 0,
+                             "unknown image format '%s' (use .exr, .png or .pfm)", path);
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        return 0;
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (!dir[0])
+        return 0;
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "output directory '%s' does not exist", dir);
+    return 0;
+}
+
+static int parse(int argc, char **argv, render_args *a, cdl_error *err)
+{
+    memset(a, 0, sizeof *a);
+    a->integrator = "path";
+    a->spp = 0;
+    a->width = 512;
+    a->height = 512;
+    a->fov = 40.0;
+    a->maxdepth = 64;
+    a->seed = 1;
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i];
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
+            render_help();
+            return -1;
+        }
+        if (!strcmp(o, "-q") || !strcmp(o, "--quiet")) {
+            cdl_log_quiet = 1;
+            continue;
+        }
+        if (o[0] != '-' || !o[1]) {
+            if (a->scene)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "only one scene file may be given");
+            a->scene = o;
+            continue;
+        }
+        /* Every other option takes the next argument as its value, even
+         * one that starts with '-' (so --spp -5 is an error about --spp). */
+        static const char *valued[] = {"-i", "--integrator", "-o", "--output", "--spp", "--time",
+                                       "--res", "--lookat", "--fov", "--maxdepth", "--seed",
+                                       "--threads", "--point-light", "--exposure"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
+            known |= !strcmp(o, valued[k]);
+        if (!known)
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "unknown option (see candela render --help)");
+        if (i + 1 >= argc)
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
+        const char *v = argv[++i];
+        long l;
+        double d;
+        int rc = 0;
+        if (!strcmp(o, "-i") || !strcmp(o, "--integrator")) {
+            if (!cdl_integrator_find(v))
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "unknown integrator '%s' (see --help)", v);
+            a->integrator = v;
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
+            if (a->nout == MAX_OUT)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "at most %d outputs", MAX_OUT);
+            rc = check_output(v, err);
+            a->out[a->nout++] = v;
+        } else if (!strcmp(o, "--spp")) {
+            rc = cdl_arg_int(o, v, 1, 1000000, &a->spp, err);
+        } else if (!strcmp(o, "--time")) {
+            rc = cdl_arg_float(o, v, 1e-3, 1e7, &a->time, err);
+        } else if (!strcmp(o, "--res")) {
+            rc = cdl_arg_res(o, v, 16384, &a->width, &a->height, err);
+        } else if (!strcmp(o, "--lookat")) {
+            rc = cdl_arg_floats(o, v, 9, a->lookat, err);
+            a->has_lookat = 1;
+        } else if (!strcmp(o, "--fov")) {
+            rc = cdl_arg_float(o, v, 1e-3, 179.999, &a->fov, err);
+        } else if (!strcmp(o, "--maxdepth")) {
+            rc = cdl_arg_int(o, v, 0, 1024, &a->maxdepth, err);
+        } else if (!strcmp(o, "--seed")) {
+            rc = cdl_arg_int(o, v, 0, 2147483647L, &l, err);
+            a->seed = (unsigned long long)l;
+        } else if (!strcmp(o, "--threads")) {
+            rc = cdl_arg_int(o, v, 1, 1024, &a->threads, err);
+        } else if (!strcmp(o, "--point-light")) {
+            if (a->nlights == MAX_POINT_LIGHTS)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "at most %d point lights", MAX_POINT_LIGHTS);
+            float *pl = a->lights[a->nlights++];
+            rc = cdl_arg_floats(o, v, 6, pl, err);
+            if (!rc && (pl[3] < 0.0f || pl[4] < 0.0f || pl[5] < 0.0f))
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "intensity must not be negative, got '%s'", v);
+        } else if (!strcmp(o, "--exposure")) {
+            rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
+            a->exposure = d;
+        }
+        if (rc)
+            return rc;
+    }
+    if (!a->scene)
+        return cdl_error_set(err, CDL_ERR_USAGE, "render", 0, "no scene file given (see candela render --help)");
+    if (a->spp && a->time > 0.0)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--time", 0, "give either --spp or --time, not both");
+    if (!a->spp && a->time <= 0.0)
+        a->spp = 64;
+    return 0;
+}
+
+static void on_sigint(int sig)
+{
+    (void)sig;
+    cdl_cancel = 1;
+    signal(SIGINT, SIG_DFL); /* a second Ctrl-C ends at once */
+}
+
+/* Default camera: looks down -z at the bounds' centre from far enough
+ * that the bounding sphere fills the vertical field of view. */
+static int frame_scene(const cdl_scene *s, double fov, int w, int h, cdl_camera *cam, cdl_error *err)
+{
+    cdl_vec3 c = cdl_scale(cdl_add(s->bmin, s->bmax), 0.5f);
+    float r = 0.5f * cdl_length(cdl_sub(s->bmax, s->bmin));
+    float dist = r / sinf(0.5f * (float)fov * CDL_PI / 180.0f);
+    cdl_vec3 eye = cdl_add(c, cdl_v3(0.0f, 0.0f, dist));
+    return cdl_camera_init(cam, eye, c, cdl_v3(0.0f, 1.0f, 0.0f), (float)fov, w, h, err);
+}
+
+static void default_output(const char *scene, char *buf, size_t n)
+{
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
+    const char *dot = strrchr(base, '.');
+    int len = dot ? (int)(dot - base) : (int)strlen(base);
+    snprintf(buf, n, "%.*s.exr", len, base);
+}
+
+int cdl_cmd_render(int argc, char **argv)
+{
+    render_args a;
+    cdl_error err;
+    int rc = parse(argc, argv, &a, &err);
+    if (rc < 0)
+        return 0;
+    if (rc)
+        return cdl_report(&err);
+    char defout[1024];
+    if (a.nout == 0) {
+        default_output(a.scene, defout, sizeof defout);
+        a.out[a.nout++] = defout;
+    }
+    if (a.threads > 0)
+        omp_set_num_threads((int)a.threads);
+
+    double t_load = cdl_time_now();
+    cdl_scene scene;
+    cdl_options opt;
+    cdl_integrator integ = {0};
+    cdl_film film = {0};
+    cdl_image img = {0};
+    rc = cdl_scene_init(&scene, a.scene, &err);
+    if (!rc)
+        rc = cdl_scene_load(&scene, a.scene, &err);
+    for (int i = 0; !rc && i < a.nlights; i++)
+        rc = cdl_scene_add_point_light(&scene, cdl_v3(a.lights[i][0], a.lights[i][1], a.lights[i][2]),
+                                       cdl_v3(a.lights[i][3], a.lights[i][4], a.lights[i][5]), &err);
+    if (!rc)
+        rc = cdl_scene_commit(&scene, &err);
+    cdl_options_default(&opt);
+    opt.maxdepth = (int)a.maxdepth;
+    opt.seed = a.seed;
+    if (!rc && a.has_lookat)
+        rc = cdl_camera_init(&opt.camera, cdl_v3(a.lookat[0], a.lookat[1], a.lookat[2]),
+                             cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),
+                             cdl_v3(a.lookat[6], a.lookat[7], a.lookat[8]), (float)a.fov, a.width,
+                             a.height, &err);
+    else if (!rc)
+        rc = frame_scene(&scene, a.fov, a.width, a.height, &opt.camera, &err);
+    if (!rc)
+        rc = cdl_integrator_create(a.integrator, &integ, &err);
+    if (!rc && integ.vt->prepare(integ.self, &scene, &opt))
+        rc = cdl_error_set(&err, CDL_ERR_INPUT, a.scene, 0, "integrator %s could not prepare the scene",
+                           a.integrator);
+    if (!rc)
+        rc = cdl_film_init(&film, a.width, a.height, &err);
+    if (rc) {
+        int status = cdl_report(&err);
+        cdl_integrator_destroy(&integ);
+        cdl_scene_free(&scene);
+        return status;
+    }
+    t_load = cdl_time_now() - t_load;
+
+    signal(SIGINT, on_sigint);
+    cdl_progress prog;
+    cdl_progress_begin(&prog);
+    double t0 = cdl_time_now();
+    uint32_t pass = 0;
+    char label[64];
+    for (;;) {
+        double el = cdl_time_now() - t0;
+        if (a.spp ? pass >= (uint32_t)a.spp : (pass > 0 && el + el / pass > a.time))
+            break;
+        if (cdl_cancel)
+            break;
+        integ.vt->render_pass(integ.self, &film, pass);
+        if (cdl_cancel)
+            break; /* the interrupted pass left some pixels with one more sample */
+        pass++;
+        snprintf(label, sizeof label, "%u spp", pass);
+        el = cdl_time_now() - t0;
+        cdl_progress_update(&prog, a.spp ? (double)pass / a.spp : el / a.time, label);
+    }
+    double t_render = cdl_time_now() - t0;
+    cdl_progress_end(&prog);
+    signal(SIGINT, SIG_DFL);
+
+    char s_spp[32], s_seed[32], s_time[32], cmdline[4096] = "candela";
+    snprintf(s_spp, sizeof s_spp, "%u", pass);
+    snprintf(s_seed, sizeof s_seed, "%llu", a.seed);
+    snprintf(s_time, sizeof s_time, "%.3f", t_render);
+    for (int i = 0; i < argc; i++) {
+        size_t len = strlen(cmdline);
+        snprintf(cmdline + len, sizeof cmdline - len, " %s", argv[i]);
+    }
+    cdl_kv meta[] = {{"integrator", a.integrator}, {"spp", s_spp}, {"seed", s_seed},
+                     {"renderTime", s_time},       {"commandLine", cmdline}};
+    rc = cdl_film_resolve(&film, &img, &err);
+    for (int i = 0; !rc && i < a.nout; i++)
+        rc = cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
+    int status = rc ? cdl_report(&err) : 0;
+    if (!rc) {
+        double mrays = t_render > 0.0 ? (double)film.rays / t_render * 1e-6 : 0.0;
+        printf("%s: %s %dx%d, %u spp in %.2f s (load %.2f s), %.2f Mrays/s, %d threads, "
+               "%llu non-finite samples%s -> %s%s\n",
+               a.scene, a.integrator, a.width, a.height, pass, t_render, t_load, mrays,
+               omp_get_max_threads(), (unsigned long long)film.nonfinite,
+               cdl_cancel ? " (interrupted)" : "", a.out[0], a.nout > 1 ? " ..." : "");
+    }
+    if (film.nonfinite && !cdl_log_quiet)
+        cdl_warn(a.scene, 0, "%llu samples were NaN or infinite and counted as black",
+                 (unsigned long long)film.nonfinite);
+    cdl_image_free(&img);
+    cdl_film_free(&film);
+    cdl_integrator_destroy(&integ);
+    cdl_scene_free(&scene);
+    if (!status && cdl_cancel)
+        return 130;
+    return status;
+}

@@ -1,0 +1,32 @@
+/* Walker/Vose alias table: O(1) sampling of a discrete distribution
+ * (light selection proportional to power). */
+#ifndef CDL_ALIAS_H
+#define CDL_ALIAS_H
+
+#include <stdint.h>
+
+typedef struct cdl_alias {
+    uint32_t n;
+    float *prob;     /* acceptance probability of each slot */
+    uint32_t *alias; /* fallback index of each slot */
+    float *pmf;      /* normalized weights */
+} cdl_alias;
+
+/* Weights must be finite and >= 0 with a positive sum; returns 0 on success,
+ * -1 otherwise (bad weights or out of memory). */
+int cdl_alias_build(cdl_alias *a, const float *w, uint32_t n);
+void cdl_alias_free(cdl_alias *a);
+
+static inline uint32_t cdl_alias_sample(const cdl_alias *a, float u, float *pmf)
+{
+    float x = u * (float)a->n;
+    uint32_t i = (uint32_t)x;
+    if (i >= a->n)
+        i = a->n - 1;
+    uint32_t k = (x - (float)i) < a->prob[i] ? i : a->alias[i];
+    if (pmf)
+        *pmf = a->pmf[k];
+    return k;
+}
+
+#endif

@@ -1,0 +1,41 @@
+/* The film: per-pixel sums of radiance samples with a one-pixel box
+ * filter. A pixel is written by one thread at a time (passes split the
+ * image into tiles), so sums need no atomics and are deterministic. */
+#ifndef CDL_FILM_H
+#define CDL_FILM_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+#include "film/image.h"
+
+typedef struct cdl_film {
+    int width, height;
+    double *sum;        /* 3 per pixel */
+    uint32_t *count;    /* samples per pixel */
+    uint64_t nonfinite; /* samples dropped as NaN/Inf (counted as zero) */
+    uint64_t rays;      /* rays traced into this film, all threads */
+} cdl_film;
+
+int cdl_film_init(cdl_film *f, int width, int height, cdl_error *err);
+void cdl_film_free(cdl_film *f);
+
+/* Adds one sample to pixel (x, y); returns 1 if it was non-finite and so
+ * counted as black (the caller sums those up into f->nonfinite). */
+static inline int cdl_film_add(cdl_film *f, int x, int y, cdl_vec3 L)
+{
+    size_t i = (size_t)y * (size_t)f->width + (size_t)x;
+    f->count[i]++;
+    if (!cdl_is_finite3(L))
+        return 1;
+    f->sum[3 * i] += L.x;
+    f->sum[3 * i + 1] += L.y;
+    f->sum[3 * i + 2] += L.z;
+    return 0;
+}
+
+/* Average per pixel into img (allocated here). */
+int cdl_film_resolve(const cdl_film *f, cdl_image *img, cdl_error *err);
+
+#endif

@@ -1,0 +1,53 @@
+/* RGB float images and their files (OpenEXR, PNG, PFM).
+ * Pixels are linear RGB, row-major, top row first, 3 floats per pixel. */
+#ifndef CDL_IMAGE_H
+#define CDL_IMAGE_H
+
+#include <stddef.h>
+
+#include "core/error.h"
+
+typedef struct cdl_image {
+    int width, height;
+    float *rgb; /* 3*w*h floats, row-major, top row first */
+} cdl_image;
+
+typedef struct cdl_kv {
+    const char *key;
+    const char *value;
+} cdl_kv; /* string metadata */
+
+/* Zero-filled image; w, h > 0. */
+int cdl_image_alloc(cdl_image *img, int w, int h, cdl_error *err);
+/* Frees the pixels and zeroes the struct; safe on a zeroed image. */
+void cdl_image_free(cdl_image *img);
+
+/* Writes by extension (.exr, .png, .pfm, case-insensitive) to PATH.tmp-<pid>
+ * and renames it over PATH, so a reader never sees a half-written file; on
+ * failure the temp file is removed.
+ * EXR: 32-bit float R,G,B, ZIP, scanline, meta as string attributes.
+ * PNG: 8-bit sRGB of rgb * 2^exposure, clamped, NaN -> 0, meta as tEXt.
+ * PFM: "PF", little-endian (scale -1), bottom row first; meta is dropped.
+ * exposure only applies to PNG. */
+int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
+                    int nmeta, float exposure, cdl_error *err);
+
+/* Reads EXR (half/float/uint; R,G,B or Y as grey; scanline or tiled, level 0;
+ * the image is the data window), PFM (PF/Pf, either endianness) or PNG
+ * (8/16 bit, sRGB decoded to linear, alpha dropped). The format is found
+ * from the file's magic bytes. On error img is left zeroed. */
+int cdl_image_read(const char *path, cdl_image *img, cdl_error *err);
+
+/* One string attribute of an EXR header into buf (truncated to n-1 chars);
+ * CDL_ERR_INPUT if absent or not a string. */
+int cdl_image_exr_attr(const char *path, const char *key, char *buf, size_t n,
+                       cdl_error *err);
+
+/* 1 if path ends in ext (e.g. ".exr"), case-insensitive. */
+int cdl_image_has_ext(const char *path, const char *ext);
+
+/* The sRGB transfer curve (IEC 61966-2-1), for values in [0,1]. */
+float cdl_srgb_encode(float linear);
+float cdl_srgb_decode(float encoded);
+
+#endif

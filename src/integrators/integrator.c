@@ -1,0 +1,69 @@
+#include "integrators/integrator.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+volatile sig_atomic_t cdl_cancel = 0;
+
+extern const cdl_integrator_vtbl cdl_path_integrator;
+
+static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, NULL};
+
+void cdl_options_default(cdl_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->maxdepth = 64;
+    o->rr_depth = 3;
+    o->seed = 1;
+}
+
+const cdl_integrator_vtbl *const *cdl_integrator_list(void) { return all; }
+
+const cdl_integrator_vtbl *cdl_integrator_find(const char *name)
+{
+    for (int i = 0; all[i]; i++)
+        if (!strcmp(all[i]->name, name))
+            return all[i];
+    return NULL;
+}
+
+int cdl_integrator_create(const char *name, cdl_integrator *out, cdl_error *err)
+{
+    const cdl_integrator_vtbl *vt = cdl_integrator_find(name);
+    if (!vt)
+        return cdl_error_set(err, CDL_ERR_USAGE, "-i", 0, "unknown integrator '%s'", name);
+    out->vt = vt;
+    out->self = calloc(1, vt->self_size);
+    if (!out->self)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");
+    return 0;
+}
+
+void cdl_integrator_destroy(cdl_integrator *it)
+{
+    if (it->self && it->vt->destroy)
+        it->vt->destroy(it->self);
+    free(it->self);
+    it->self = NULL;
+}
+
+void cdl_render_tiles(void *self, cdl_film *film, uint32_t pass, cdl_tile_fn fn)
+{
+    enum { T = 16 };
+    int tx = (film->width + T - 1) / T, ty = (film->height + T - 1) / T;
+    int ntiles = tx * ty;
+    uint64_t rays = 0, bad = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, bad)
+    for (int t = 0; t < ntiles; t++) {
+        if (cdl_cancel)
+            continue;
+        int x0 = (t % tx) * T, y0 = (t / tx) * T;
+        int x1 = x0 + T < film->width ? x0 + T : film->width;
+        int y1 = y0 + T < film->height ? y0 + T : film->height;
+        uint64_t r = 0;
+        bad += fn(self, film, x0, y0, x1, y1, pass, &r);
+        rays += r;
+    }
+    film->rays += rays;
+    film->nonfinite += bad;
+}

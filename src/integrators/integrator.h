@@ -1,0 +1,54 @@
+/* The interface every light-transport method implements (DESIGN.md):
+ * prepare once, then progressive passes. A pass is deterministic given
+ * (seed, pass index) whatever the number of threads. */
+#ifndef CDL_INTEGRATOR_H
+#define CDL_INTEGRATOR_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "film/film.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+typedef struct cdl_options {
+    cdl_camera camera;
+    int maxdepth;   /* bounces, as in pbrt: 1 = direct light only */
+    int rr_depth;   /* Russian roulette starts after this many bounces */
+    uint64_t seed;
+} cdl_options;
+
+void cdl_options_default(cdl_options *o);
+
+typedef struct cdl_integrator_vtbl {
+    const char *name;
+    const char *summary; /* one line for --help */
+    int (*prepare)(void *self, const cdl_scene *scene, const cdl_options *opt);
+    int (*render_pass)(void *self, cdl_film *film, uint32_t pass);
+    void (*destroy)(void *self);
+    size_t self_size;
+} cdl_integrator_vtbl;
+
+typedef struct cdl_integrator {
+    const cdl_integrator_vtbl *vt;
+    void *self;
+} cdl_integrator;
+
+/* Set from a signal handler: passes stop at the next tile. */
+extern volatile sig_atomic_t cdl_cancel;
+
+const cdl_integrator_vtbl *cdl_integrator_find(const char *name);
+/* Names of all integrators, NULL-terminated. */
+const cdl_integrator_vtbl *const *cdl_integrator_list(void);
+int cdl_integrator_create(const char *name, cdl_integrator *out, cdl_error *err);
+void cdl_integrator_destroy(cdl_integrator *it);
+
+/* Runs fn(self, x0, y0, x1, y1, rays) over the image in 16x16 tiles on
+ * all threads; sums the ray and non-finite counts into the film. The
+ * tile callback returns its non-finite sample count. */
+typedef uint64_t (*cdl_tile_fn)(void *self, cdl_film *film, int x0, int y0, int x1, int y1,
+                                uint32_t pass, uint64_t *rays);
+void cdl_render_tiles(void *self, cdl_film *film, uint32_t pass, cdl_tile_fn fn);
+
+#endif

@@ -1,0 +1,138 @@
+/* path: unidirectional path tracing, the reference of candela.
+ *
+ * Next-event estimation at every non-delta vertex (one light chosen in
+ * proportion to its power through the alias table, one point on it),
+ * combined with BSDF sampling by multiple importance sampling with the
+ * power heuristic (Veach 1997, ch. 9). Russian roulette on the throughput
+ * after opt.rr_depth bounces, survival at least 5 %.
+ *
+ * Options: --maxdepth N  bounces (1 = direct light only), default 64.
+ */
+#include <float.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "integrators/integrator.h"
+
+typedef struct path_state {
+    const cdl_scene *scene;
+    cdl_options opt;
+} path_state;
+
+static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+{
+    path_state *ps = self;
+    ps->scene = scene;
+    ps->opt = *opt;
+    return 0;
+}
+
+/* Direct light at a surface point by light sampling, MIS-weighted
+ * against the BSDF having found the same point. */
+static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b,
+                           cdl_vec3 wo, cdl_rng *rng, uint64_t *rays)
+{
+    float pmf;
+    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, cdl_rng_float(rng), &pmf)];
+    cdl_light_sample ls;
+    float u1 = cdl_rng_float(rng), u2 = cdl_rng_float(rng);
+    if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi);
+    if (cdl_is_black(f))
+        return f;
+    cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
+    (*rays)++;
+    if (cdl_occluded(s, o, ls.wi, ls.dist * (1.0f - 1e-4f)))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    float pdf_l = ls.pdf * pmf;
+    float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
+    float w = ls.delta ? 1.0f : cdl_power_heuristic(pdf_l, cdl_bsdf_pdf(b, wo, ls.wi));
+    return cdl_scale(cdl_mul(f, ls.Li), cos * w / pdf_l);
+}
+
+static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_rng *rng,
+                         uint64_t *rays)
+{
+    const cdl_scene *s = ps->scene;
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f), beta = cdl_v3(1.0f, 1.0f, 1.0f);
+    int specular = 1;
+    float pdf_prev = 0.0f;
+    for (int depth = 0;; depth++) {
+        cdl_hit h;
+        (*rays)++;
+        if (!cdl_intersect(s, o, d, FLT_MAX, &h))
+            break;
+        cdl_surface sf;
+        cdl_surface_at(s, &h, &sf);
+        cdl_vec3 wo = cdl_neg(d);
+        if (sf.light >= 0 && cdl_dot(wo, sf.ng) > 0.0f) {
+            const cdl_light *l = &s->lights[sf.light];
+            float w = 1.0f;
+            if (!specular) {
+                float pdf_l = s->light_select.pmf[sf.light] * h.t * h.t /
+                              (cdl_dot(wo, sf.ng) * l->area);
+                w = cdl_power_heuristic(pdf_prev, pdf_l);
+            }
+            L = cdl_add(L, cdl_scale(cdl_mul(beta, l->L), w));
+        }
+        if (depth >= ps->opt.maxdepth)
+            break;
+        cdl_bsdf b;
+        cdl_scene_bsdf(s, &sf, &b);
+        if (!cdl_bsdf_is_delta(&b))
+            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, rng, rays)));
+        cdl_scatter bs;
+        float u0 = cdl_rng_float(rng), u1 = cdl_rng_float(rng), u2 = cdl_rng_float(rng);
+        if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &bs))
+            break;
+        beta = cdl_mul(beta, bs.weight);
+        specular = bs.delta;
+        pdf_prev = bs.pdf;
+        o = cdl_offset(s, sf.p, sf.ng, bs.wi);
+        d = bs.wi;
+        if (depth + 1 >= ps->opt.rr_depth) {
+            float q = fmaxf(0.05f, 1.0f - cdl_max3(beta));
+            if (cdl_rng_float(rng) < q)
+                break;
+            beta = cdl_scale(beta, 1.0f / (1.0f - q));
+        }
+        if (cdl_is_black(beta))
+            break;
+    }
+    return L;
+}
+
+static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, int y1,
+                          uint32_t pass, uint64_t *rays)
+{
+    const path_state *ps = self;
+    const cdl_camera *cam = &ps->opt.camera;
+    uint64_t bad = 0, npix = (uint64_t)film->width * (uint64_t)film->height;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            cdl_rng rng;
+            cdl_rng_seed(&rng, ps->opt.seed, (uint64_t)pass * npix + (uint64_t)y * film->width + x);
+            float fx = (float)x + cdl_rng_float(&rng), fy = (float)y + cdl_rng_float(&rng);
+            cdl_vec3 L = radiance(ps, cam->eye, cdl_camera_ray(cam, fx, fy), &rng, rays);
+            bad += (uint64_t)cdl_film_add(film, x, y, L);
+        }
+    return bad;
+}
+
+static int path_render_pass(void *self, cdl_film *film, uint32_t pass)
+{
+    cdl_render_tiles(self, film, pass, path_tile);
+    return 0;
+}
+
+static void path_destroy(void *self) { (void)self; }
+
+const cdl_integrator_vtbl cdl_path_integrator = {
+    .name = "path",
+    .summary = "path tracing with next-event estimation and MIS (the reference)",
+    .prepare = path_prepare,
+    .render_pass = path_render_pass,
+    .destroy = path_destroy,
+    .self_size = sizeof(path_state),
+};

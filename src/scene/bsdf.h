@@ -1,0 +1,45 @@
+/* BSDFs: a material evaluated at a surface point. Directions are world
+ * space unit vectors pointing away from the surface; f excludes the cosine.
+ * `adjoint` selects importance transport (light paths): refraction then
+ * carries no 1/eta^2 radiance scaling. */
+#ifndef CDL_BSDF_H
+#define CDL_BSDF_H
+
+#include "scene/material.h"
+
+typedef struct cdl_bsdf {
+    cdl_mat_type type;
+    cdl_vec3 kd, ks;
+    float ns, eta;
+    float p_spec;    /* probability of sampling the Phong lobe */
+    cdl_frame frame; /* shading frame; n = shading normal, front side */
+    cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
+} cdl_bsdf;
+
+typedef struct cdl_scatter {
+    cdl_vec3 wi;
+    cdl_vec3 weight; /* f * |cos(wi, n)| / pdf */
+    float pdf;       /* solid angle; for delta events the discrete probability */
+    int delta;       /* 1 if wi came from a specular (Dirac) component */
+} cdl_scatter;
+
+/* Builds the BSDF at a hit: kd already includes the texture. */
+void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
+                   cdl_vec3 ns, cdl_vec3 ng);
+
+static inline int cdl_bsdf_is_delta(const cdl_bsdf *b)
+{
+    return b->type == CDL_MAT_MIRROR || b->type == CDL_MAT_DIELECTRIC;
+}
+
+cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi);
+float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi);
+/* Returns 0 when no direction could be sampled (the path ends). */
+int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
+                    int adjoint, cdl_scatter *s);
+
+/* Fresnel reflectance of a smooth dielectric; cos_i > 0 on the side of
+ * the incident direction, eta = eta_t / eta_i. */
+float cdl_fresnel_dielectric(float cos_i, float eta);
+
+#endif

@@ -1,0 +1,327 @@
+#include "scene/scene.h"
+
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Grows *buf (elem bytes each) to hold at least need elements. */
+static int grow(void **buf, uint32_t *cap, uint32_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 0;
+    uint64_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    if (c > UINT32_MAX / 2)
+        return -1;
+    void *p = realloc(*buf, (size_t)c * elem);
+    if (!p)
+        return -1;
+    *buf = p;
+    *cap = (uint32_t)c;
+    return 0;
+}
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    (void)user;
+    fprintf(stderr, "candela: embree error %d: %s\n", (int)code, str ? str : "");
+}
+
+int cdl_scene_init(cdl_scene *s, const char *path, cdl_error *err)
+{
+    memset(s, 0, sizeof *s);
+    snprintf(s->path, sizeof s->path, "%s", path ? path : "");
+    s->device = rtcNewDevice(NULL);
+    if (!s->device)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "cannot create Embree device (error %d)",
+                             (int)rtcGetDeviceError(NULL));
+    rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    return 0;
+}
+
+void cdl_scene_free(cdl_scene *s)
+{
+    if (s->rtc)
+        rtcReleaseScene(s->rtc);
+    if (s->device)
+        rtcReleaseDevice(s->device);
+    free(s->pos);
+    free(s->nrm);
+    free(s->uv);
+    free(s->idx);
+    free(s->tri_mat);
+    free(s->tri_flags);
+    free(s->face_n);
+    free(s->tri_light);
+    free(s->mats);
+    for (uint32_t i = 0; i < s->ntexs; i++)
+        cdl_texture_free(&s->texs[i]);
+    free(s->texs);
+    free(s->lights);
+    cdl_alias_free(&s->light_select);
+    memset(s, 0, sizeof *s);
+}
+
+int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float *nrm,
+                           const float *uv, uint32_t *first, cdl_error *err)
+{
+    if (n > UINT32_MAX / 4 - s->nverts)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "too many vertices");
+    uint32_t need = s->nverts + n + 1; /* +1: Embree reads 16 bytes per vertex */
+    uint32_t cp = s->cap_verts, cn = s->cap_verts, cu = s->cap_verts;
+    if (grow((void **)&s->pos, &cp, need, 3 * sizeof(float)) ||
+        grow((void **)&s->nrm, &cn, need, 3 * sizeof(float)) ||
+        grow((void **)&s->uv, &cu, need, 2 * sizeof(float)))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for %u vertices", need);
+    s->cap_verts = cp < cn ? (cp < cu ? cp : cu) : (cn < cu ? cn : cu);
+    for (uint32_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            float x = p[3 * i + k];
+            if (!isfinite(x) || fabsf(x) > CDL_MAX_COORD)
+                return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
+                                     "vertex %u has an invalid coordinate %g", i, (double)x);
+        }
+    }
+    memcpy(s->pos + 3 * (size_t)s->nverts, p, 3 * sizeof(float) * n);
+    if (nrm)
+        memcpy(s->nrm + 3 * (size_t)s->nverts, nrm, 3 * sizeof(float) * n);
+    else
+        memset(s->nrm + 3 * (size_t)s->nverts, 0, 3 * sizeof(float) * n);
+    if (uv)
+        memcpy(s->uv + 2 * (size_t)s->nverts, uv, 2 * sizeof(float) * n);
+    else
+        memset(s->uv + 2 * (size_t)s->nverts, 0, 2 * sizeof(float) * n);
+    memset(s->pos + 3 * (size_t)(s->nverts + n), 0, 3 * sizeof(float)); /* padding */
+    *first = s->nverts;
+    s->nverts += n;
+    return 0;
+}
+
+int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
+                           uint32_t mat, uint8_t flags, cdl_error *err)
+{
+    if (a >= s->nverts || b >= s->nverts || c >= s->nverts || mat >= s->nmats)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "triangle index out of range");
+    /* Zero-area triangles carry no light and break normals: skip them. */
+    const float *pa = s->pos + 3 * (size_t)a, *pb = s->pos + 3 * (size_t)b, *pc = s->pos + 3 * (size_t)c;
+    cdl_vec3 e1 = cdl_v3(pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]);
+    cdl_vec3 e2 = cdl_v3(pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]);
+    cdl_vec3 n = cdl_cross(e1, e2);
+    float len = cdl_length(n);
+    if (!(len > 0.0f) || !isfinite(len))
+        return 0;
+    uint32_t ci = s->cap_tris, cm = s->cap_tris, cf = s->cap_tris;
+    if (grow((void **)&s->idx, &ci, s->ntris + 1, 3 * sizeof(uint32_t)) ||
+        grow((void **)&s->tri_mat, &cm, s->ntris + 1, sizeof(uint32_t)) ||
+        grow((void **)&s->tri_flags, &cf, s->ntris + 1, sizeof(uint8_t)))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for triangles");
+    s->cap_tris = ci < cm ? (ci < cf ? ci : cf) : (cm < cf ? cm : cf);
+    uint32_t *t = s->idx + 3 * (size_t)s->ntris;
+    t[0] = a;
+    t[1] = b;
+    t[2] = c;
+    s->tri_mat[s->ntris] = mat;
+    s->tri_flags[s->ntris] = flags;
+    s->ntris++;
+    return 0;
+}
+
+int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err)
+{
+    if (grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for materials");
+    s->mats[s->nmats] = *m;
+    *id = s->nmats++;
+    return 0;
+}
+
+int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *err)
+{
+    if (grow((void **)&s->texs, &s->cap_texs, s->ntexs + 1, sizeof(cdl_texture)))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for textures");
+    int rc = cdl_texture_load(&s->texs[s->ntexs], path, err);
+    if (rc)
+        return rc;
+    *id = (int)s->ntexs++;
+    return 0;
+}
+
+static int add_light(cdl_scene *s, const cdl_light *l, cdl_error *err)
+{
+    if (grow((void **)&s->lights, &s->cap_lights, s->nlights + 1, sizeof *l))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for lights");
+    s->lights[s->nlights++] = *l;
+    return 0;
+}
+
+int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err)
+{
+    cdl_light l;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_POINT;
+    l.p = p;
+    l.L = I;
+    return add_light(s, &l, err);
+}
+
+static int build_lights(cdl_scene *s, cdl_error *err)
+{
+    s->tri_light = malloc(sizeof(int32_t) * (s->ntris ? s->ntris : 1));
+    s->face_n = malloc(sizeof(cdl_vec3) * (s->ntris ? s->ntris : 1));
+    if (!s->tri_light || !s->face_n)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    for (uint32_t i = 0; i < s->ntris; i++) {
+        const uint32_t *t = s->idx + 3 * (size_t)i;
+        cdl_vec3 p0 = cdl_v3(s->pos[3 * t[0]], s->pos[3 * t[0] + 1], s->pos[3 * t[0] + 2]);
+        cdl_vec3 p1 = cdl_v3(s->pos[3 * t[1]], s->pos[3 * t[1] + 1], s->pos[3 * t[1] + 2]);
+        cdl_vec3 p2 = cdl_v3(s->pos[3 * t[2]], s->pos[3 * t[2] + 1], s->pos[3 * t[2] + 2]);
+        cdl_vec3 e1 = cdl_sub(p1, p0), e2 = cdl_sub(p2, p0);
+        cdl_vec3 c = cdl_cross(e1, e2);
+        float len = cdl_length(c);
+        s->face_n[i] = cdl_scale(c, 1.0f / len);
+        s->tri_light[i] = -1;
+        const cdl_material *m = &s->mats[s->tri_mat[i]];
+        if (cdl_is_black(m->ke))
+            continue;
+        cdl_light l;
+        memset(&l, 0, sizeof l);
+        l.type = CDL_LIGHT_TRIANGLE;
+        l.p = p0;
+        l.e1 = e1;
+        l.e2 = e2;
+        l.n = s->face_n[i];
+        l.area = 0.5f * len;
+        l.L = m->ke;
+        l.prim = i;
+        s->tri_light[i] = (int32_t)s->nlights;
+        if (add_light(s, &l, err))
+            return err->code;
+    }
+    if (s->nlights == 0)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
+                             "scene has no light (no material with Ke > 0 and no --point-light)");
+    float *w = malloc(sizeof(float) * s->nlights);
+    if (!w)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    for (uint32_t i = 0; i < s->nlights; i++) {
+        cdl_vec3 P = cdl_light_power(&s->lights[i]);
+        w[i] = (P.x + P.y + P.z) / 3.0f;
+    }
+    int rc = cdl_alias_build(&s->light_select, w, s->nlights);
+    free(w);
+    if (rc)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "lights have no finite positive power");
+    return 0;
+}
+
+int cdl_scene_commit(cdl_scene *s, cdl_error *err)
+{
+    if (s->ntris == 0)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "scene has no (non-degenerate) triangles");
+    int rc = build_lights(s, err);
+    if (rc)
+        return rc;
+    cdl_vec3 lo = cdl_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = cdl_scale(lo, -1.0f);
+    for (uint32_t i = 0; i < 3 * s->ntris; i++) {
+        const float *p = s->pos + 3 * (size_t)s->idx[i];
+        lo = cdl_v3(fminf(lo.x, p[0]), fminf(lo.y, p[1]), fminf(lo.z, p[2]));
+        hi = cdl_v3(fmaxf(hi.x, p[0]), fmaxf(hi.y, p[1]), fmaxf(hi.z, p[2]));
+    }
+    s->bmin = lo;
+    s->bmax = hi;
+    s->eps = 1e-6f * cdl_max3(cdl_sub(hi, lo));
+
+    s->rtc = rtcNewScene(s->device);
+    RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!s->rtc || !g)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree could not create the scene");
+    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->pos, 0,
+                               3 * sizeof(float), s->nverts);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->idx, 0,
+                               3 * sizeof(uint32_t), s->ntris);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(s->rtc, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(s->rtc);
+    enum RTCError e = rtcGetDeviceError(s->device);
+    if (e != RTC_ERROR_NONE)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree failed to build the scene (error %d)", (int)e);
+    return 0;
+}
+
+void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
+                         const cdl_vec3 *d, const float *tmax, uint8_t *blocked)
+{
+    enum { CHUNK = 64 };
+    struct RTCRay rays[CHUNK];
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (uint32_t base = 0; base < n; base += CHUNK) {
+        uint32_t m = n - base < CHUNK ? n - base : CHUNK;
+        for (uint32_t i = 0; i < m; i++) {
+            struct RTCRay *r = &rays[i];
+            r->org_x = o[base + i].x;
+            r->org_y = o[base + i].y;
+            r->org_z = o[base + i].z;
+            r->dir_x = d[base + i].x;
+            r->dir_y = d[base + i].y;
+            r->dir_z = d[base + i].z;
+            r->tnear = 0.0f;
+            r->tfar = tmax[base + i];
+            r->mask = 0xFFFFFFFFu;
+            r->flags = 0;
+            r->time = 0.0f;
+        }
+        rtcOccluded1M(s->rtc, &ctx, rays, m, sizeof(struct RTCRay));
+        for (uint32_t i = 0; i < m; i++)
+            blocked[base + i] = rays[i].tfar < 0.0f;
+    }
+}
+
+void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+{
+    const uint32_t *t = s->idx + 3 * (size_t)h->prim;
+    float b0 = 1.0f - h->b1 - h->b2;
+    const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
+                *p2 = s->pos + 3 * (size_t)t[2];
+    /* Barycentric position: closer to the surface than o + t d. */
+    sf->p = cdl_v3(b0 * p0[0] + h->b1 * p1[0] + h->b2 * p2[0],
+                   b0 * p0[1] + h->b1 * p1[1] + h->b2 * p2[1],
+                   b0 * p0[2] + h->b1 * p1[2] + h->b2 * p2[2]);
+    sf->ng = s->face_n[h->prim];
+    sf->ns = sf->ng;
+    uint8_t fl = s->tri_flags[h->prim];
+    if (fl & CDL_TRI_HAS_N) {
+        const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
+                    *n2 = s->nrm + 3 * (size_t)t[2];
+        cdl_vec3 n = cdl_v3(b0 * n0[0] + h->b1 * n1[0] + h->b2 * n2[0],
+                            b0 * n0[1] + h->b1 * n1[1] + h->b2 * n2[1],
+                            b0 * n0[2] + h->b1 * n1[2] + h->b2 * n2[2]);
+        float len = cdl_length(n);
+        if (len > 1e-12f && isfinite(len))
+            sf->ns = cdl_scale(n, 1.0f / len);
+    }
+    sf->u = sf->v = 0.0f;
+    if (fl & CDL_TRI_HAS_UV) {
+        const float *u0 = s->uv + 2 * (size_t)t[0], *u1 = s->uv + 2 * (size_t)t[1],
+                    *u2 = s->uv + 2 * (size_t)t[2];
+        sf->u = b0 * u0[0] + h->b1 * u1[0] + h->b2 * u2[0];
+        sf->v = b0 * u0[1] + h->b1 * u1[1] + h->b2 * u2[1];
+    }
+    sf->prim = h->prim;
+    sf->mat = s->tri_mat[h->prim];
+    sf->light = s->tri_light[h->prim];
+}
+
+void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
+{
+    const cdl_material *m = &s->mats[sf->mat];
+    cdl_vec3 kd = m->kd;
+    if (m->kd_tex >= 0)
+        kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
+    cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
+}

@@ -1,0 +1,155 @@
+/* The scene: one triangle soup in one Embree geometry (primID = triangle
+ * index), materials, textures and lights. Loaders fill it through the
+ * cdl_scene_add_* calls, then cdl_scene_commit validates it and builds
+ * the BVH, the light list and the light-selection table. */
+#ifndef CDL_SCENE_H
+#define CDL_SCENE_H
+
+#include <embree3/rtcore.h>
+#include <stdint.h>
+
+#include "core/alias.h"
+#include "core/error.h"
+#include "scene/bsdf.h"
+#include "scene/light.h"
+#include "scene/material.h"
+#include "scene/texture.h"
+
+/* Coordinates beyond this are rejected as absurd: float spacing there is
+ * larger than any sensible scene detail. */
+#define CDL_MAX_COORD 1e20f
+
+typedef struct cdl_scene {
+    RTCDevice device;
+    RTCScene rtc;
+
+    uint32_t nverts, ntris, cap_verts, cap_tris;
+    float *pos;        /* 3 per vertex, padded for Embree's 16-byte loads */
+    float *nrm;        /* 3 per vertex (zero where the mesh had none) */
+    float *uv;         /* 2 per vertex */
+    uint32_t *idx;     /* 3 per triangle */
+    uint32_t *tri_mat; /* material per triangle */
+    uint8_t *tri_flags;
+    cdl_vec3 *face_n;  /* unit CCW normal per triangle (after commit) */
+    int32_t *tri_light; /* light index per triangle or -1 (after commit) */
+
+    cdl_material *mats;
+    uint32_t nmats, cap_mats;
+    cdl_texture *texs;
+    uint32_t ntexs, cap_texs;
+    cdl_light *lights;
+    uint32_t nlights, cap_lights;
+    cdl_alias light_select;
+
+    cdl_vec3 bmin, bmax; /* bounds of the geometry (after commit) */
+    float eps;           /* ray offset scale (after commit) */
+    char path[1024];     /* file the scene came from, for messages */
+} cdl_scene;
+
+enum { CDL_TRI_HAS_N = 1, CDL_TRI_HAS_UV = 2 };
+
+int cdl_scene_init(cdl_scene *s, const char *path, cdl_error *err);
+void cdl_scene_free(cdl_scene *s);
+
+/* Appends vertices (uv and n may be NULL); returns the first new index
+ * through *first. */
+int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float *nrm,
+                           const float *uv, uint32_t *first, cdl_error *err);
+int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
+                           uint32_t mat, uint8_t flags, cdl_error *err);
+int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err);
+int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *err);
+/* I is the intensity in W/sr. */
+int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err);
+int cdl_scene_commit(cdl_scene *s, cdl_error *err);
+
+/* ---- ray queries ---- */
+
+typedef struct cdl_hit {
+    float t, b1, b2; /* distance and barycentrics of vertices 1 and 2 */
+    uint32_t prim;
+} cdl_hit;
+
+typedef struct cdl_surface {
+    cdl_vec3 p, ng, ns; /* ng: unit CCW normal */
+    float u, v;
+    uint32_t prim, mat;
+    int32_t light;      /* index of the area light on this triangle, or -1 */
+} cdl_surface;
+
+static inline struct RTCIntersectContext cdl_context(void)
+{
+    struct RTCIntersectContext c;
+    rtcInitIntersectContext(&c);
+    c.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    return c;
+}
+
+/* Closest hit along o + t d, t in (0, tmax); returns 0 on a miss. */
+static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float tmax,
+                                cdl_hit *h)
+{
+    struct RTCIntersectContext ctx = cdl_context();
+    struct RTCRayHit rh;
+    rh.ray.org_x = o.x;
+    rh.ray.org_y = o.y;
+    rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x;
+    rh.ray.dir_y = d.y;
+    rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.flags = 0;
+    rh.ray.time = 0.0f;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    h->t = rh.ray.tfar;
+    h->b1 = rh.hit.u;
+    h->b2 = rh.hit.v;
+    h->prim = rh.hit.primID;
+    return 1;
+}
+
+/* 1 if anything blocks o + t d for t in (0, tmax). */
+static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float tmax)
+{
+    struct RTCIntersectContext ctx = cdl_context();
+    struct RTCRay r;
+    r.org_x = o.x;
+    r.org_y = o.y;
+    r.org_z = o.z;
+    r.dir_x = d.x;
+    r.dir_y = d.y;
+    r.dir_z = d.z;
+    r.tnear = 0.0f;
+    r.tfar = tmax;
+    r.mask = 0xFFFFFFFFu;
+    r.flags = 0;
+    r.time = 0.0f;
+    rtcOccluded1(s->rtc, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+/* A bundle of shadow rays traced together as an Embree ray stream
+ * (coherent when they share an end point, as the point-light methods'
+ * bundles do). Sets hit[i] = 1 where ray i is blocked. */
+void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
+                         const cdl_vec3 *d, const float *tmax, uint8_t *blocked);
+
+void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
+/* Texture lookup folded in. */
+void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
+
+/* Origin for a ray leaving p in direction d: pushed off the surface along
+ * ng to the side d goes to, so the ray cannot hit the surface it left. */
+static inline cdl_vec3 cdl_offset(const cdl_scene *s, cdl_vec3 p, cdl_vec3 ng, cdl_vec3 d)
+{
+    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
+    float e = s->eps + m * 1e-5f;
+    return cdl_madd(p, ng, cdl_dot(d, ng) < 0.0f ? -e : e);
+}
+
+#endif
