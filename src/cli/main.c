@@ -45,6 +45,6 @@ int main(int argc, char **argv)
         return 0;
     }
     cdl_error err;
-    cdl_error_set(&err, CDL_ERR_USAGE, "", 0, "unknown command '%s' (try candela --help)", argv[1]);
+    cdl_error_set(&err, CDL_ERR_USAGE, argv[1], 0, "unknown command (try candela --help)");
     return cdl_report(&err);
 }

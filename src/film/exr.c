@@ -196,10 +196,9 @@ static int read_pixels(exr_context_t ctx, const char *path, cdl_image *img,
     exr_attr_box2i_t dw;
     const exr_attr_chlist_t *chl = NULL;
     exr_result_t rv;
-    int npart = 0;
 
-    if ((rv = exr_get_count(ctx, &npart)) != EXR_ERR_SUCCESS ||
-        (rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS ||
+    /* Multi-part files: the first part is the image. */
+    if ((rv = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS ||
         (rv = exr_get_data_window(ctx, 0, &dw)) != EXR_ERR_SUCCESS ||
         (rv = exr_get_channels(ctx, 0, &chl)) != EXR_ERR_SUCCESS)
         return exr_fail(err, CDL_ERR_INPUT, path, "bad OpenEXR header", rv, m);
@@ -279,7 +278,6 @@ static int read_pixels(exr_context_t ctx, const char *path, cdl_image *img,
     if (grey) /* Y was decoded into R; grey means R = G = B */
         for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
             img->rgb[3 * i + 1] = img->rgb[3 * i + 2] = img->rgb[3 * i];
-    (void)npart; /* multi-part files: the first part is the image */
     return 0;
 }
 

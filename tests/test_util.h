@@ -1,0 +1,53 @@
+/* Helpers for tests that build scenes in code and render them. */
+#ifndef CDL_TEST_UTIL_H
+#define CDL_TEST_UTIL_H
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "integrators/integrator.h"
+#include "scene/scene.h"
+
+static int test_failures = 0;
+
+#define CHECK(cond, ...)                                                                           \
+    do {                                                                                           \
+        int ok_ = (cond);                                                                          \
+        printf("%s: ", ok_ ? "ok  " : "FAIL");                                                     \
+        printf(__VA_ARGS__);                                                                       \
+        printf("\n");                                                                              \
+        if (!ok_)                                                                                  \
+            test_failures++;                                                                       \
+    } while (0)
+
+static void die_on(int rc, const cdl_error *err)
+{
+    if (rc) {
+        char buf[2048];
+        cdl_error_format(err, buf, sizeof buf);
+        fprintf(stderr, "setup failed: %s\n", buf);
+        exit(2);
+    }
+}
+
+/* Renders passes [0, npass) of `integrator` into a new film. */
+static void render_film(const char *integrator, const cdl_scene *s, const cdl_options *opt,
+                        int w, int h, uint32_t npass, cdl_film *film)
+{
+    cdl_error err;
+    cdl_integrator it;
+    die_on(cdl_integrator_create(integrator, &it, &err), &err);
+    die_on(it.vt->prepare(it.self, s, opt), &err);
+    die_on(cdl_film_init(film, w, h, &err), &err);
+    for (uint32_t p = 0; p < npass; p++)
+        it.vt->render_pass(it.self, film, p);
+    cdl_integrator_destroy(&it);
+}
+
+static double film_pixel(const cdl_film *f, int x, int y, int c)
+{
+    size_t i = (size_t)y * (size_t)f->width + (size_t)x;
+    return f->sum[3 * i + c] / f->count[i];
+}
+
+#endif

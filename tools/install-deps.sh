@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages candela builds and tests with (Debian 12).
+# Runs apt-get only for what is missing, so it is cheap to call again.
+set -eu
+pkgs="build-essential cmake pkg-config libembree-dev libopenexr-dev libpng-dev libassimp-dev libstb-dev"
+missing=""
+for p in $pkgs; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  echo "installing:$missing"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq $missing
+fi
