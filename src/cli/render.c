@@ -35,6 +35,7 @@ typedef struct render_args {
     float lights[MAX_POINT_LIGHTS][6];
     int nlights;
     double exposure;
+    cdl_sampler_kind sampler;
 } render_args;
 
 static void render_help(void)
@@ -54,6 +55,7 @@ static void render_help(void)
            "                          without --lookat the camera frames the scene's bounds\n"
            "      --maxdepth N        maximum bounces (1 = direct light only; default 64)\n"
            "      --seed N            random seed (default 1); same seed, same image\n"
+           "      --sampler NAME      sobol (Owen-scrambled, default) or independent\n"
            "      --threads N         worker threads (default: all cores)\n"
            "      --point-light x,y,z,r,g,b   add a point light of intensity (r,g,b) W/sr;\n"
            "                          repeatable\n"
@@ -117,7 +119,7 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
          * one that starts with '-' (so --spp -5 is an error about --spp). */
         static const char *valued[] = {"-i", "--integrator", "-o", "--output", "--spp", "--time",
                                        "--res", "--lookat", "--fov", "--maxdepth", "--seed",
-                                       "--threads", "--point-light", "--exposure"};
+                                       "--threads", "--point-light", "--exposure", "--sampler"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(o, valued[k]);
@@ -163,6 +165,13 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
             rc = cdl_arg_floats(o, v, 6, pl, err);
             if (!rc && (pl[3] < 0.0f || pl[4] < 0.0f || pl[5] < 0.0f))
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "intensity must not be negative, got '%s'", v);
+        } else if (!strcmp(o, "--sampler")) {
+            if (!strcmp(v, "sobol"))
+                a->sampler = CDL_SAMPLER_SOBOL;
+            else if (!strcmp(v, "independent"))
+                a->sampler = CDL_SAMPLER_INDEPENDENT;
+            else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected sobol or independent, got '%s'", v);
         } else if (!strcmp(o, "--exposure")) {
             rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
             a->exposure = d;
@@ -240,6 +249,7 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_options_default(&opt);
     opt.maxdepth = (int)a.maxdepth;
     opt.seed = a.seed;
+    opt.sampler = a.sampler;
     if (!rc && a.has_lookat)
         rc = cdl_camera_init(&opt.camera, cdl_v3(a.lookat[0], a.lookat[1], a.lookat[2]),
                              cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),

@@ -18,13 +18,13 @@ static inline cdl_vec3 cdl_sample_cosine_hemisphere(float u1, float u2)
         phi = (CDL_PI / 2.0f) - (CDL_PI / 4.0f) * (a / b);
     }
     float x = r * cosf(phi), y = r * sinf(phi);
-    return cdl_v3(x, y, sqrtf(fmaxf(0.0f, 1.0f - x * x - y * y)));
+    return cdl_v3(x, y, sqrtf(cdl_maxf(0.0f, 1.0f - x * x - y * y)));
 }
 
 static inline cdl_vec3 cdl_sample_uniform_sphere(float u1, float u2)
 {
     float z = 1.0f - 2.0f * u1;
-    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float r = sqrtf(cdl_maxf(0.0f, 1.0f - z * z));
     float phi = 2.0f * CDL_PI * u2;
     return cdl_v3(r * cosf(phi), r * sinf(phi), z);
 }

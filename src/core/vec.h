@@ -25,7 +25,10 @@ static inline cdl_vec3 cdl_cross(cdl_vec3 a, cdl_vec3 b)
 }
 static inline float cdl_length(cdl_vec3 a) { return sqrtf(cdl_dot(a, a)); }
 static inline cdl_vec3 cdl_normalize(cdl_vec3 a) { return cdl_scale(a, 1.0f / cdl_length(a)); }
-static inline float cdl_max3(cdl_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+/* Plain comparisons: fmaxf's NaN rules keep it from inlining. */
+static inline float cdl_maxf(float a, float b) { return a > b ? a : b; }
+static inline float cdl_minf(float a, float b) { return a < b ? a : b; }
+static inline float cdl_max3(cdl_vec3 a) { return cdl_maxf(a.x, cdl_maxf(a.y, a.z)); }
 static inline float cdl_luminance(cdl_vec3 a) { return 0.2126f * a.x + 0.7152f * a.y + 0.0722f * a.z; }
 static inline int cdl_is_black(cdl_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 static inline int cdl_is_finite3(cdl_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }

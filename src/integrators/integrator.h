@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "core/sampler.h"
 #include "film/film.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -17,6 +18,7 @@ typedef struct cdl_options {
     int maxdepth;   /* bounces, as in pbrt: 1 = direct light only */
     int rr_depth;   /* Russian roulette starts after this many bounces */
     uint64_t seed;
+    cdl_sampler_kind sampler; /* Sobol (default) or independent */
 } cdl_options;
 
 void cdl_options_default(cdl_options *o);

@@ -10,7 +10,7 @@
  */
 #include <float.h>
 
-#include "core/rng.h"
+#include "core/sampler.h"
 #include "core/sampling.h"
 #include "integrators/integrator.h"
 
@@ -30,12 +30,12 @@ static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *o
 /* Direct light at a surface point by light sampling, MIS-weighted
  * against the BSDF having found the same point. */
 static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b,
-                           cdl_vec3 wo, cdl_rng *rng, uint64_t *rays)
+                           cdl_vec3 wo, cdl_sampler *smp, uint64_t *rays)
 {
-    float pmf;
-    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, cdl_rng_float(rng), &pmf)];
+    float pmf, u1, u2;
+    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, cdl_sampler_1d(smp), &pmf)];
     cdl_light_sample ls;
-    float u1 = cdl_rng_float(rng), u2 = cdl_rng_float(rng);
+    cdl_sampler_2d(smp, &u1, &u2);
     if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi);
@@ -51,7 +51,7 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
     return cdl_scale(cdl_mul(f, ls.Li), cos * w / pdf_l);
 }
 
-static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_rng *rng,
+static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampler *smp,
                          uint64_t *rays)
 {
     const cdl_scene *s = ps->scene;
@@ -81,9 +81,10 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_rng *
         cdl_bsdf b;
         cdl_scene_bsdf(s, &sf, &b);
         if (!cdl_bsdf_is_delta(&b))
-            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, rng, rays)));
+            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, smp, rays)));
         cdl_scatter bs;
-        float u0 = cdl_rng_float(rng), u1 = cdl_rng_float(rng), u2 = cdl_rng_float(rng);
+        float u0 = cdl_sampler_1d(smp), u1, u2;
+        cdl_sampler_2d(smp, &u1, &u2);
         if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &bs))
             break;
         beta = cdl_mul(beta, bs.weight);
@@ -92,8 +93,8 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_rng *
         o = cdl_offset(s, sf.p, sf.ng, bs.wi);
         d = bs.wi;
         if (depth + 1 >= ps->opt.rr_depth) {
-            float q = fmaxf(0.05f, 1.0f - cdl_max3(beta));
-            if (cdl_rng_float(rng) < q)
+            float q = cdl_maxf(0.05f, 1.0f - cdl_max3(beta));
+            if (cdl_sampler_cheap(smp) < q)
                 break;
             beta = cdl_scale(beta, 1.0f / (1.0f - q));
         }
@@ -108,13 +109,14 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
 {
     const path_state *ps = self;
     const cdl_camera *cam = &ps->opt.camera;
-    uint64_t bad = 0, npix = (uint64_t)film->width * (uint64_t)film->height;
+    uint64_t bad = 0;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
-            cdl_rng rng;
-            cdl_rng_seed(&rng, ps->opt.seed, (uint64_t)pass * npix + (uint64_t)y * film->width + x);
-            float fx = (float)x + cdl_rng_float(&rng), fy = (float)y + cdl_rng_float(&rng);
-            cdl_vec3 L = radiance(ps, cam->eye, cdl_camera_ray(cam, fx, fy), &rng, rays);
+            cdl_sampler smp;
+            float jx, jy;
+            cdl_sampler_start(&smp, ps->opt.sampler, ps->opt.seed, (uint64_t)y * film->width + x, pass);
+            cdl_sampler_2d(&smp, &jx, &jy);
+            cdl_vec3 L = radiance(ps, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy), &smp, rays);
             bad += (uint64_t)cdl_film_add(film, x, y, L);
         }
     return bad;

@@ -112,7 +112,7 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     if (u0 < b->p_spec) {
         /* cos^n lobe around the mirror direction */
         float cos_a = powf(u1, 1.0f / (b->ns + 1.0f));
-        float sin_a = sqrtf(fmaxf(0.0f, 1.0f - cos_a * cos_a));
+        float sin_a = sqrtf(cdl_maxf(0.0f, 1.0f - cos_a * cos_a));
         float phi = 2.0f * CDL_PI * u2;
         cdl_frame rf = cdl_frame_from(cdl_v3(-lo.x, -lo.y, lo.z));
         li = cdl_to_world(&rf, cdl_v3(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
@@ -176,7 +176,7 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
             return 1;
         }
         float sin2_t = (1.0f - cos_o * cos_o) / (eta * eta);
-        float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
+        float cos_t = sqrtf(cdl_maxf(0.0f, 1.0f - sin2_t));
         s->wi = cdl_sub(cdl_scale(cdl_neg(wo), 1.0f / eta),
                         cdl_scale(n, cos_t - cos_o / eta));
         s->wi = cdl_normalize(s->wi);

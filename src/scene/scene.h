@@ -147,7 +147,7 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
  * ng to the side d goes to, so the ray cannot hit the surface it left. */
 static inline cdl_vec3 cdl_offset(const cdl_scene *s, cdl_vec3 p, cdl_vec3 ng, cdl_vec3 d)
 {
-    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
+    float m = cdl_maxf(fabsf(p.x), cdl_maxf(fabsf(p.y), fabsf(p.z)));
     float e = s->eps + m * 1e-5f;
     return cdl_madd(p, ng, cdl_dot(d, ng) < 0.0f ? -e : e);
 }

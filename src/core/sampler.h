@@ -1,0 +1,127 @@
+/* Padded, Owen-scrambled Sobol sampler (Burley 2020, "Practical hash-based
+ * Owen scrambling"). Each 1D or 2D request uses the first two dimensions of
+ * the Sobol sequence (a (0,2)-sequence), with the sample index shuffled and
+ * the points scrambled by hashes of (seed, pixel, dimension). Every pair
+ * of dimensions is then stratified over passes like a (0,2)-sequence at
+ * every power of two, and progressive rendering keeps that property: the
+ * sample index is the pass number. */
+#ifndef CDL_SAMPLER_H
+#define CDL_SAMPLER_H
+
+#include <stdint.h>
+
+#include "core/rng.h"
+
+typedef enum cdl_sampler_kind { CDL_SAMPLER_SOBOL, CDL_SAMPLER_INDEPENDENT } cdl_sampler_kind;
+
+typedef struct cdl_sampler {
+    uint64_t key;   /* hash of (seed, pixel or path) */
+    uint32_t index; /* sample (pass) number */
+    uint32_t dim;
+    uint32_t cheap; /* draws of cdl_sampler_cheap so far */
+    cdl_sampler_kind kind;
+    cdl_rng rng;    /* CDL_SAMPLER_INDEPENDENT: plain PCG32 stream */
+} cdl_sampler;
+
+static inline uint32_t cdl_reverse_bits(uint32_t x)
+{
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+    x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+    x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+    return x;
+}
+
+/* Laine-Karras hash: output bit j depends only on input bits <= j. On a
+ * bit-reversed value that is an Owen scramble (each digit permuted
+ * depending on the digits above it). */
+static inline uint32_t cdl_lk_hash(uint32_t x, uint32_t seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+/* Sobol dimension 1 in reversed bit order (dimension 0 reversed is the
+ * index itself). Its generator matrix is Pascal's triangle mod 2, i.e.
+ * the polynomial map p(t) -> p(t + 1), done in five butterfly steps since
+ * (t + 1)^(2^k) = t^(2^k) + 1 (mod 2). */
+static inline uint32_t cdl_sobol_dim1_reversed(uint32_t i)
+{
+    i ^= (i & 0xaaaaaaaau) >> 1;
+    i ^= (i & 0xccccccccu) >> 2;
+    i ^= (i & 0xf0f0f0f0u) >> 4;
+    i ^= (i & 0xff00ff00u) >> 8;
+    i ^= (i & 0xffff0000u) >> 16;
+    return i;
+}
+
+static inline float cdl_u32_to_float(uint32_t x)
+{
+    return (float)(x >> 8) * 0x1p-24f;
+}
+
+/* stream identifies the pixel (or light path); index is the pass. */
+static inline void cdl_sampler_start(cdl_sampler *s, cdl_sampler_kind kind, uint64_t seed,
+                                     uint64_t stream, uint32_t index)
+{
+    s->kind = kind;
+    s->key = cdl_mix64(seed * 0x9e3779b97f4a7c15ULL ^ cdl_mix64(stream));
+    s->index = index;
+    s->dim = 0;
+    s->cheap = 0;
+    s->rng.state = s->rng.inc = 0;
+    if (kind == CDL_SAMPLER_INDEPENDENT)
+        cdl_rng_seed(&s->rng, seed, cdl_mix64(stream) ^ ((uint64_t)index << 40) ^ index);
+}
+
+/* Shuffled index for the current dimension: an Owen scramble of the
+ * index bits, so every aligned block of 2^k passes stays a (0,k,2)-net. */
+static inline uint32_t cdl_sampler_next(cdl_sampler *s, uint32_t *s1, uint32_t *s2)
+{
+    uint64_t h = cdl_mix64(s->key + (uint64_t)s->dim * 0x9e3779b97f4a7c15ULL);
+    s->dim++;
+    *s1 = (uint32_t)(h >> 32);
+    *s2 = ((uint32_t)h ^ 0x9e3779b9u) * 0x85ebca6bu ^ *s1;
+    return cdl_reverse_bits(cdl_lk_hash(cdl_reverse_bits(s->index), (uint32_t)h));
+}
+
+static inline float cdl_sampler_1d(cdl_sampler *s)
+{
+    if (s->kind == CDL_SAMPLER_INDEPENDENT)
+        return cdl_rng_float(&s->rng);
+    uint32_t s1, s2;
+    uint32_t i = cdl_sampler_next(s, &s1, &s2);
+    return cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(i, s1)));
+}
+
+/* A decision that gains nothing from stratification (Russian roulette):
+ * a plain hash of the state, consuming no dimension. */
+static inline float cdl_sampler_cheap(cdl_sampler *s)
+{
+    if (s->kind == CDL_SAMPLER_INDEPENDENT)
+        return cdl_rng_float(&s->rng);
+    /* key stays fixed per pixel (the scrambles must not change between
+     * passes); the pass index makes each pass's decision independent. */
+    uint64_t h = cdl_mix64(s->key ^ ((uint64_t)s->index << 32) ^ (0xc2b2ae35u + s->cheap++));
+    return cdl_u32_to_float((uint32_t)h);
+}
+
+static inline void cdl_sampler_2d(cdl_sampler *s, float *u, float *v)
+{
+    if (s->kind == CDL_SAMPLER_INDEPENDENT) {
+        *u = cdl_rng_float(&s->rng);
+        *v = cdl_rng_float(&s->rng);
+        return;
+    }
+    uint32_t s1, s2;
+    uint32_t i = cdl_sampler_next(s, &s1, &s2);
+    *u = cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(i, s1)));
+    *v = cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(cdl_sobol_dim1_reversed(i), s2)));
+}
+
+#endif

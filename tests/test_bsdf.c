@@ -1,0 +1,913 @@
+/* Statistical and exactness tests of the BSDFs (scene/bsdf.c).
+ *
+ * Opaque materials (Lambert, Phong at several exponents, Phong without a
+ * diffuse part), for several outgoing directions on both sides of the
+ * geometric normal, with the shading normal equal to the geometric normal
+ * and tilted from it:
+ *  - chi-square goodness of fit of cdl_bsdf_sample against cdl_bsdf_pdf,
+ *    binned over the whole sphere in the geometric normal's frame (and, for
+ *    Phong, a second time in the frame of the lobe axis, where the bins
+ *    resolve the lobe); expected counts by adaptive quadrature of the pdf;
+ *    failed samples form their own bin (mass of the pdf missing on the sphere);
+ *  - the pdf integrates to 1 (or to the sample success rate when part of the
+ *    lobe lies below the surface, never above 1);
+ *  - per-sample consistency of pdf and weight with cdl_bsdf_pdf / _eval;
+ *  - weight bound, reciprocity of eval, directional albedo (Monte Carlo and
+ *    by quadrature of f |cos|).
+ * Mirror and dielectric: exact reflection / Snell directions, Fresnel
+ * reflection probability, total internal reflection, weights for radiance
+ * and importance transport.
+ *
+ * Deterministic seeds: the outcome never changes between runs. Returns 0
+ * when every check passes. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/rng.h"
+#include "core/vec.h"
+#include "scene/bsdf.h"
+#include "scene/material.h"
+
+#define PI_D 3.14159265358979323846
+#define DEG (PI_D / 180.0)
+
+static int failures, checks;
+
+/* Significance of the chi-square tests: 1% for the whole program,
+ * Sidak-corrected over its N_CHI2 tests. Seeds are fixed, so a run never
+ * flakes; the correction keeps a correct implementation passing with
+ * probability 0.99 even when another compiler or -march changes the float
+ * bits and so the samples. Real defects give p-values of ~0. */
+#define FAMILY_ALPHA 0.01
+#define N_CHI2 132
+#define P_MIN (1.0 - pow(1.0 - FAMILY_ALPHA, 1.0 / N_CHI2))
+static int chi2_count;
+
+/* Prints "<message> ok" or "<message> FAIL" and counts failures. */
+static void check(int ok, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    printf(ok ? " ok\n" : " FAIL\n");
+    checks++;
+    if (!ok)
+        failures++;
+}
+
+/* ---- double precision vectors ------------------------------------------ */
+
+typedef struct dvec {
+    double x, y, z;
+} dvec;
+
+static dvec dv(double x, double y, double z) { return (dvec){x, y, z}; }
+static dvec dadd(dvec a, dvec b) { return dv(a.x + b.x, a.y + b.y, a.z + b.z); }
+static dvec dsub(dvec a, dvec b) { return dv(a.x - b.x, a.y - b.y, a.z - b.z); }
+static dvec dscale(dvec a, double s) { return dv(a.x * s, a.y * s, a.z * s); }
+static double ddot(dvec a, dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dvec dcross(dvec a, dvec b)
+{
+    return dv(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static dvec dnorm(dvec a) { return dscale(a, 1.0 / sqrt(ddot(a, a))); }
+static dvec from_f(cdl_vec3 a) { return dv(a.x, a.y, a.z); }
+static cdl_vec3 to_f(dvec a) { return cdl_v3((float)a.x, (float)a.y, (float)a.z); }
+static double dangle(dvec a, dvec b)
+{
+    return atan2(sqrt(ddot(dcross(a, b), dcross(a, b))), ddot(a, b));
+}
+
+typedef struct dframe {
+    dvec t, b, n;
+} dframe;
+
+static dframe dframe_from(dvec n)
+{
+    dframe f;
+    f.n = n;
+    dvec a = fabs(n.x) < 0.7 ? dv(1, 0, 0) : dv(0, 1, 0);
+    f.t = dnorm(dsub(a, dscale(n, ddot(a, n))));
+    f.b = dcross(n, f.t);
+    return f;
+}
+static dvec dframe_dir(const dframe *f, double c, double phi)
+{
+    double s = sqrt(fmax(0.0, 1.0 - c * c));
+    return dadd(dadd(dscale(f->t, s * cos(phi)), dscale(f->b, s * sin(phi))), dscale(f->n, c));
+}
+/* (cos theta, phi in [0, 2 pi)) of a direction in a frame. */
+static void dframe_coords(const dframe *f, dvec w, double *c, double *phi)
+{
+    *c = ddot(w, f->n);
+    double p = atan2(ddot(w, f->b), ddot(w, f->t));
+    *phi = p < 0.0 ? p + 2.0 * PI_D : p;
+}
+
+/* ---- chi-square --------------------------------------------------------- */
+
+/* Regularized upper incomplete gamma Q(a, x) (Numerical Recipes 6.2). */
+static double gamma_q(double a, double x)
+{
+    if (!(a > 0.0) || x < 0.0)
+        return NAN;
+    if (x == 0.0)
+        return 1.0;
+    double lpre = -x + a * log(x) - lgamma(a);
+    if (x < a + 1.0) {
+        double ap = a, del = 1.0 / a, sum = del;
+        for (int n = 0; n < 100000; n++) {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+            if (fabs(del) < fabs(sum) * 1e-16)
+                break;
+        }
+        return fmax(0.0, 1.0 - sum * exp(lpre));
+    }
+    const double tiny = 1e-300;
+    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+    for (int i = 1; i < 100000; i++) {
+        double an = -i * (i - a);
+        b += 2.0;
+        d = an * d + b;
+        if (fabs(d) < tiny)
+            d = tiny;
+        c = b + an / c;
+        if (fabs(c) < tiny)
+            c = tiny;
+        d = 1.0 / d;
+        double del = d * c;
+        h *= del;
+        if (fabs(del - 1.0) < 1e-16)
+            break;
+    }
+    return exp(lpre) * h;
+}
+
+typedef struct chi2_result {
+    double stat, p;
+    int dof;
+    double zero_hits; /* samples in bins of expected count 0 */
+} chi2_result;
+
+static const double *sort_key;
+static int by_key(const void *a, const void *b)
+{
+    double x = sort_key[*(const int *)a], y = sort_key[*(const int *)b];
+    return x < y ? -1 : x > y;
+}
+
+/* Pearson's test; bins expecting fewer than min_exp are pooled into one
+ * bin, itself merged into the smallest regular bin if still too small.
+ * Bins where the quadrature found no mass at all are pooled too (a sliver
+ * of the support may escape every quadrature node); zero_hits counts their
+ * samples. Samples where the pdf really is 0 are caught one by one by the
+ * consistency checks (sample pdf > 0 and equal to cdl_bsdf_pdf). */
+static chi2_result chi2_test(const double *obs, const double *expd, int n, double min_exp)
+{
+    chi2_result r = {0.0, 1.0, 0, 0.0};
+    int *idx = malloc(sizeof(int) * (size_t)n);
+    for (int i = 0; i < n; i++)
+        idx[i] = i;
+    sort_key = expd;
+    qsort(idx, (size_t)n, sizeof(int), by_key);
+    double po = 0.0, pe = 0.0;
+    int nb = 0;
+    for (int k = 0; k < n; k++) {
+        double o = obs[idx[k]], e = expd[idx[k]];
+        if (e <= 0.0)
+            r.zero_hits += o;
+        if (e < min_exp) {
+            po += o;
+            pe += e;
+            continue;
+        }
+        if ((pe > 0.0 || po > 0.0) && pe < min_exp) {
+            o += po;
+            e += pe;
+            po = pe = 0.0;
+        }
+        r.stat += (o - e) * (o - e) / e;
+        nb++;
+    }
+    if (pe > 0.0) {
+        r.stat += (po - pe) * (po - pe) / pe;
+        nb++;
+    } else if (po > 0.0) {
+        r.p = 0.0; /* samples and nowhere any expected mass */
+    }
+    free(idx);
+    r.dof = nb - 1;
+    chi2_count++;
+    if (r.p > 0.0)
+        r.p = r.dof >= 1 ? gamma_q(0.5 * r.dof, 0.5 * r.stat) : 1.0;
+    return r;
+}
+
+static void test_gamma(void)
+{
+    /* Q(1/2, x) = erfc(sqrt x), Q(1, x) = exp(-x), Q(5, x) = exp(-x) sum x^k/k!. */
+    double worst = 0.0;
+    for (double x = 0.01; x < 60.0; x *= 1.37) {
+        double e5 = 0.0, term = 1.0;
+        for (int k = 0; k < 5; k++) {
+            e5 += term;
+            term *= x / (k + 1);
+        }
+        e5 *= exp(-x);
+        double refs[3] = {erfc(sqrt(x)), exp(-x), e5}, as[3] = {0.5, 1.0, 5.0};
+        for (int i = 0; i < 3; i++) {
+            double q = gamma_q(as[i], x);
+            double err = fabs(q - refs[i]) / fmax(refs[i], 1e-300);
+            if (refs[i] > 1e-250 && err > worst)
+                worst = err;
+        }
+    }
+    check(worst < 1e-9, "gamma_q against closed forms: max relative error %.2e (< 1e-9)", worst);
+    double p = gamma_q(0.5, 3.841458820694124 / 2.0);
+    check(fabs(p - 0.05) < 1e-9, "chi2 p-value of 3.8415 with 1 dof: %.9f (0.05)", p);
+}
+
+/* ---- adaptive quadrature over (cos theta, phi) rectangles -------------- */
+
+/* Integrand: [0] = pdf(wo, wi), [1] = f(wo, wi).x |cos(wi, shading n)|. */
+typedef struct integ {
+    const cdl_bsdf *b;
+    cdl_vec3 wo;
+    dframe fr;       /* frame of the (cos theta, phi) coordinates */
+    int has_lobe;    /* force refinement around a narrow lobe */
+    dvec lobe;
+    double sigma;    /* angular width of the lobe */
+    int albedo;      /* also integrate f |cos| */
+    long evals;
+} integ;
+
+#define TOL_ABS 3e-8
+#define TOL_REL 1e-5
+#define MAX_DEPTH 8
+#define MIN_DEPTH 1 /* every bin gets at least 4x4 cells of 4x4 nodes */
+
+static const double gl_x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                               0.8611363115940526};
+static const double gl_w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
+                               0.3478548451374538};
+
+static void integrand(integ *g, double c, double phi, double out[2])
+{
+    cdl_vec3 wi = to_f(dframe_dir(&g->fr, c, phi));
+    g->evals++;
+    out[0] = cdl_bsdf_pdf(g->b, g->wo, wi);
+    out[1] = 0.0;
+    if (g->albedo) {
+        cdl_vec3 f = cdl_bsdf_eval(g->b, g->wo, wi);
+        out[1] = f.x * fabs(cdl_dot(wi, g->b->frame.n));
+    }
+}
+
+static void gl_cell(integ *g, double c0, double c1, double p0, double p1, double out[2])
+{
+    double cm = 0.5 * (c0 + c1), ch = 0.5 * (c1 - c0), pm = 0.5 * (p0 + p1), ph = 0.5 * (p1 - p0);
+    out[0] = out[1] = 0.0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double v[2];
+            integrand(g, cm + ch * gl_x[i], pm + ph * gl_x[j], v);
+            out[0] += gl_w[i] * gl_w[j] * v[0];
+            out[1] += gl_w[i] * gl_w[j] * v[1];
+        }
+    out[0] *= ch * ph;
+    out[1] *= ch * ph;
+}
+
+/* Whether a cell is too coarse for the lobe: angular radius above half the
+ * lobe width and the lobe axis within a few widths of the cell. */
+static int near_lobe(const integ *g, double c0, double c1, double p0, double p1)
+{
+    if (!g->has_lobe)
+        return 0;
+    double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
+    dvec ctr = dframe_dir(&g->fr, cm, pm);
+    double cs[2] = {c0, c1}, ps[3] = {p0, pm, p1}, rad = 0.0;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 3; j++)
+            rad = fmax(rad, dangle(ctr, dframe_dir(&g->fr, cs[i], ps[j])));
+    return rad > 0.5 * g->sigma && dangle(ctr, g->lobe) < rad + 6.0 * g->sigma;
+}
+
+static void adapt(integ *g, double c0, double c1, double p0, double p1, const double whole[2],
+                  int depth, double acc[2])
+{
+    double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
+    double q[4][2], sum[2] = {0.0, 0.0};
+    double cc[4][2] = {{c0, cm}, {c0, cm}, {cm, c1}, {cm, c1}};
+    double pp[4][2] = {{p0, pm}, {pm, p1}, {p0, pm}, {pm, p1}};
+    for (int k = 0; k < 4; k++) {
+        gl_cell(g, cc[k][0], cc[k][1], pp[k][0], pp[k][1], q[k]);
+        sum[0] += q[k][0];
+        sum[1] += q[k][1];
+    }
+    int done = depth >= MAX_DEPTH;
+    if (!done && depth >= MIN_DEPTH) {
+        done = 1;
+        for (int i = 0; i < 2; i++)
+            if (fabs(sum[i] - whole[i]) > fmax(TOL_ABS, TOL_REL * fabs(sum[i])))
+                done = 0;
+        if (done && near_lobe(g, c0, c1, p0, p1))
+            done = 0;
+    }
+    if (done) {
+        acc[0] += sum[0];
+        acc[1] += sum[1];
+        return;
+    }
+    for (int k = 0; k < 4; k++)
+        adapt(g, cc[k][0], cc[k][1], pp[k][0], pp[k][1], q[k], depth + 1, acc);
+}
+
+static void integrate_cell(integ *g, double c0, double c1, double p0, double p1, double out[2])
+{
+    double whole[2];
+    gl_cell(g, c0, c1, p0, p1, whole);
+    out[0] = out[1] = 0.0;
+    adapt(g, c0, c1, p0, p1, whole, 0, out);
+}
+
+/* ---- opaque materials ---------------------------------------------------- */
+
+#define NC 10 /* cos theta bins over [-1, 1] */
+#define NP 20 /* phi bins */
+#define NSAMPLES 200000
+#define LOBE_T_MIN 0.02 /* lobe-frame bins cover cos^(n+1) alpha in [this, 1] */
+#define ZERO_HITS_MAX 20 /* slivers of support between quadrature nodes */
+#define COS_ABS_ERR 1e-6 /* float rounding of cos(wi, n) after a change of frame */
+
+typedef struct opaque_case {
+    const char *name;
+    cdl_mat_type type;
+    float kd, ks, ns;
+} opaque_case;
+
+static cdl_material make_material(cdl_mat_type type, float kd, float ks, float ns, float eta)
+{
+    cdl_material m;
+    memset(&m, 0, sizeof m);
+    m.type = type;
+    m.kd = cdl_v3(kd, kd, kd);
+    m.ks = cdl_v3(ks, ks, ks);
+    m.ns = ns;
+    m.eta = eta;
+    m.kd_tex = -1;
+    return m;
+}
+
+/* The geometric normal of every test: deliberately not axis aligned. */
+static dvec geo_normal(void) { return dnorm(dv(0.3, -0.5, 0.8)); }
+
+/* Direction at polar angle theta from n, azimuth phi (in n's frame). */
+static dvec polar(const dframe *f, double theta, double phi)
+{
+    return dframe_dir(f, cos(theta), phi);
+}
+
+static double rel_err(double a, double b)
+{
+    double d = fabs(a - b), m = fmax(fabs(a), fabs(b));
+    return m > 0.0 ? d / m : 0.0;
+}
+
+static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64_t stream)
+{
+    dvec ngd = geo_normal();
+    dframe gf = dframe_from(ngd);
+    dvec nsd = tilted ? polar(&gf, 10.0 * DEG, 40.0 * DEG) : ngd;
+    dvec wod = polar(&gf, wo_deg * DEG, 0.0);
+    cdl_material m = make_material(mc->type, mc->kd, mc->ks, mc->ns, 1.0f);
+    cdl_bsdf b;
+    cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
+    cdl_vec3 wo = to_f(wod);
+    char tag[160];
+    snprintf(tag, sizeof tag, "%s wo=%gdeg%s%s", mc->name, wo_deg,
+             wo_deg > 90.0 ? " (back side)" : "", tilted ? " ns tilted 10deg" : "");
+    int is_phong = mc->type == CDL_MAT_PHONG;
+    double n = mc->ns;
+
+    /* Lobe axis: mirror of wo about the shading normal. */
+    dvec nsf = from_f(b.frame.n);
+    dvec lobe = dsub(dscale(nsf, 2.0 * ddot(wod, nsf)), wod);
+    dframe lf = dframe_from(dnorm(lobe));
+    double lobe_cmin = is_phong ? pow(LOBE_T_MIN, 1.0 / (n + 1.0)) : 0.0;
+
+    /* Sampling. */
+    static double obs[NC * NP + 1], lobs[NC * NP + 1];
+    memset(obs, 0, sizeof obs);
+    memset(lobs, 0, sizeof lobs);
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 0xb5df5eedULL, stream);
+    long fails = 0, bad_side = 0, bad_unit = 0, bad_misc = 0;
+    double max_pdf_err = 0.0, max_w_err = 0.0, max_w = 0.0, wsum = 0.0, wsum2 = 0.0;
+    for (int s = 0; s < NSAMPLES; s++) {
+        float u0 = cdl_rng_float(&rng), u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
+        cdl_scatter sc;
+        if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc)) {
+            fails++;
+            obs[NC * NP] += 1.0;
+            lobs[NC * NP] += 1.0; /* the lobe frame's "rest" bin holds failures too */
+            continue;
+        }
+        if (sc.delta || !(sc.pdf > 0.0f) || !cdl_is_finite3(sc.weight) || !isfinite(sc.pdf))
+            bad_misc++;
+        dvec wi = from_f(sc.wi);
+        if (fabs(sqrt(ddot(wi, wi)) - 1.0) > 1e-5)
+            bad_unit++;
+        if (ddot(wi, ngd) * ddot(wod, ngd) <= 0.0)
+            bad_side++;
+        double pdf2 = cdl_bsdf_pdf(&b, wo, sc.wi);
+        max_pdf_err = fmax(max_pdf_err, rel_err(pdf2, sc.pdf));
+        cdl_vec3 f = cdl_bsdf_eval(&b, wo, sc.wi);
+        double cs = fabs(cdl_dot(sc.wi, b.frame.n));
+        double we[3] = {f.x * cs / sc.pdf, f.y * cs / sc.pdf, f.z * cs / sc.pdf};
+        double fs[3] = {f.x, f.y, f.z};
+        double wg[3] = {sc.weight.x, sc.weight.y, sc.weight.z};
+        for (int k = 0; k < 3; k++) {
+            /* The sampler's cosine is the local z before the rotation to
+             * world space; ours is recomputed from the float wi, off by
+             * ~1e-7 absolute, which matters for near-grazing wi. */
+            double slack = fs[k] * COS_ABS_ERR / sc.pdf;
+            max_w_err = fmax(max_w_err, fabs(we[k] - wg[k]) / (fmax(fabs(we[k]), fabs(wg[k])) + slack / 1e-3));
+            max_w = fmax(max_w, wg[k]);
+        }
+        wsum += wg[0];
+        wsum2 += wg[0] * wg[0];
+        double c, phi;
+        dframe_coords(&gf, wi, &c, &phi);
+        int ic = (int)((c + 1.0) * 0.5 * NC), ip = (int)(phi / (2.0 * PI_D) * NP);
+        ic = ic < 0 ? 0 : ic >= NC ? NC - 1 : ic;
+        ip = ip < 0 ? 0 : ip >= NP ? NP - 1 : ip;
+        obs[ic * NP + ip] += 1.0;
+        if (is_phong) {
+            dframe_coords(&lf, wi, &c, &phi);
+            if (c >= lobe_cmin) {
+                double t = pow(fmin(c, 1.0), n + 1.0);
+                int it = (int)((t - LOBE_T_MIN) / (1.0 - LOBE_T_MIN) * NC);
+                ip = (int)(phi / (2.0 * PI_D) * NP);
+                it = it < 0 ? 0 : it >= NC ? NC - 1 : it;
+                ip = ip < 0 ? 0 : ip >= NP ? NP - 1 : ip;
+                lobs[it * NP + ip] += 1.0;
+            } else {
+                lobs[NC * NP] += 1.0;
+            }
+        }
+    }
+
+    /* Expected counts by quadrature, in the geometric normal's frame. */
+    integ g = {&b, wo, gf, is_phong, dnorm(lobe), is_phong ? 1.0 / sqrt(n) : 1.0, 1, 0};
+    static double expd[NC * NP + 1], lexp[NC * NP + 1];
+    double ipdf = 0.0, ialb = 0.0;
+    for (int i = 0; i < NC; i++)
+        for (int j = 0; j < NP; j++) {
+            double v[2];
+            integrate_cell(&g, -1.0 + 2.0 * i / NC, -1.0 + 2.0 * (i + 1) / NC,
+                           2.0 * PI_D * j / NP, 2.0 * PI_D * (j + 1) / NP, v);
+            expd[i * NP + j] = v[0] * NSAMPLES;
+            ipdf += v[0];
+            ialb += v[1];
+        }
+    /* Failures form a bin of their own when some mass is expected there;
+     * otherwise (isolated failures of measure zero, e.g. u1 = 0 exactly
+     * putting a lobe sample on the horizon) they are left to the
+     * failure-rate check below. */
+    expd[NC * NP] = fmax(0.0, 1.0 - ipdf) * NSAMPLES;
+    int nbins = expd[NC * NP] >= 5.0 ? NC * NP + 1 : NC * NP;
+    chi2_result r = chi2_test(obs, expd, nbins, 5.0);
+    check(r.p >= P_MIN,
+          "%s: chi2 (cos theta, phi in ng frame, %dx%d bins%s) = %.1f, dof %d, "
+          "p-value %.4f (>= %.2g)%s",
+          tag, NC, NP, nbins > NC * NP ? " + failures" : "", r.stat, r.dof, r.p, P_MIN,
+          r.zero_hits > 0 ? " [samples in bins of expected count 0 pooled]" : "");
+    check(r.zero_hits <= ZERO_HITS_MAX,
+          "%s: %.0f samples in bins where quadrature of the pdf found no mass (<= %d)", tag,
+          r.zero_hits, ZERO_HITS_MAX);
+
+    if (is_phong) {
+        /* Bins uniform in cos^(n+1) of the angle to the lobe axis: each
+         * holds the same share of the lobe, whatever its width. */
+        g.fr = lf;
+        g.albedo = 0;
+        double icap = 0.0;
+        for (int i = 0; i < NC; i++) {
+            double c0 = pow(LOBE_T_MIN + (1.0 - LOBE_T_MIN) * i / NC, 1.0 / (n + 1.0));
+            double c1 = pow(LOBE_T_MIN + (1.0 - LOBE_T_MIN) * (i + 1) / NC, 1.0 / (n + 1.0));
+            if (i == NC - 1)
+                c1 = 1.0;
+            for (int j = 0; j < NP; j++) {
+                double v[2];
+                integrate_cell(&g, c0, c1, 2.0 * PI_D * j / NP, 2.0 * PI_D * (j + 1) / NP, v);
+                lexp[i * NP + j] = v[0] * NSAMPLES;
+                icap += v[0];
+            }
+        }
+        lexp[NC * NP] = fmax(0.0, 1.0 - icap) * NSAMPLES;
+        r = chi2_test(lobs, lexp, NC * NP + 1, 5.0);
+        check(r.p >= P_MIN,
+              "%s: chi2 (cos^(n+1) to lobe axis, phi; %dx%d bins + rest) = %.1f, dof %d, "
+              "p-value %.4f (>= %.2g)%s",
+              tag, NC, NP, r.stat, r.dof, r.p, P_MIN,
+              r.zero_hits > 0 ? " [samples in bins of expected count 0 pooled]" : "");
+        check(r.zero_hits <= ZERO_HITS_MAX,
+              "%s: lobe frame: %.0f samples in bins where quadrature of the pdf found no mass "
+              "(<= %d)",
+              tag, r.zero_hits, ZERO_HITS_MAX);
+    }
+
+    /* Mass of the pdf against the sample success rate. */
+    double succ = 1.0 - (double)fails / NSAMPLES;
+    check(ipdf <= 1.0 + 1e-3, "%s: integral of pdf over the sphere %.5f (<= 1.001)", tag, ipdf);
+    check(fabs(succ - ipdf) <= 0.01,
+          "%s: failed samples %.5f vs 1 - integral of pdf %.5f (|diff| %.5f <= 0.01)", tag,
+          1.0 - succ, 1.0 - ipdf, fabs(succ - ipdf));
+    /* All mass above the surface: Lambert, and narrow lobes far from the
+     * horizon, with the shading normal on the geometric one. */
+    double wo_front = wo_deg > 90.0 ? 180.0 - wo_deg : wo_deg;
+    int full = !tilted && (mc->type == CDL_MAT_DIFFUSE || (n >= 100.0 && wo_front <= 60.0));
+    if (full)
+        check(fabs(ipdf - 1.0) <= 0.01, "%s: integral of pdf %.5f (1 within 1%%)", tag, ipdf);
+    /* A cosine lobe about ns loses (1 - cos tilt) / 2 below the geometric
+     * surface (in the disk projection, between a half circle and a half
+     * ellipse of axes 1 and cos tilt). */
+    if (tilted && mc->type == CDL_MAT_DIFFUSE && succ > 0.0) {
+        double want = 0.5 * (1.0 + cos(10.0 * DEG));
+        check(fabs(ipdf - want) <= 1e-4,
+              "%s: integral of pdf %.5f vs (1 + cos 10deg) / 2 = %.5f (within 1e-4)", tag, ipdf,
+              want);
+    }
+
+    /* Per-sample consistency. */
+    check(bad_misc == 0 && bad_unit == 0 && bad_side == 0,
+          "%s: samples with delta/non-finite/zero pdf %ld, |wi| != 1 %ld, wi across the "
+          "geometric surface %ld (all 0)",
+          tag, bad_misc, bad_unit, bad_side);
+    check(max_pdf_err <= 1e-3, "%s: sample pdf vs cdl_bsdf_pdf: max relative error %.2e (<= 1e-3)",
+          tag, max_pdf_err);
+    check(max_w_err <= 1e-3,
+          "%s: weight vs eval |cos| / pdf: max relative error %.2e (<= 1e-3, cos +- 1e-6)", tag,
+          max_w_err);
+    /* Weight bound. With p_spec = ks / (kd + ks) the Phong weight is
+     * (kd + ks) (kd cos + ks (n+2)/2 x cos) / (kd cos + ks (n+1)/2 x), x =
+     * cos^n alpha, whose supremum (cos = x = 1, wo on the normal) is
+     * (kd + ks) (kd + ks (n+2)/2) / (kd + ks (n+1)/2): above 1 for kd 0.3,
+     * ks 0.6, n = 1 (1.2). The weight must stay <= 1 whenever that is. */
+    double wb = mc->kd;
+    if (is_phong)
+        wb = (mc->kd + mc->ks) * (mc->kd + mc->ks * (n + 2.0) / 2.0) /
+             (mc->kd + mc->ks * (n + 1.0) / 2.0);
+    double wlimit = fmax(1.0, wb) + 1e-4;
+    check(max_w <= wlimit, "%s: max sample weight %.5f (<= %.4f%s)", tag, max_w, wlimit,
+          wb > 1.0 ? ": this sampler's supremum for this material exceeds 1" : "");
+
+    /* Directional albedo. */
+    double alb = wsum / NSAMPLES;
+    double sd = sqrt(fmax(0.0, wsum2 / NSAMPLES - alb * alb) / NSAMPLES);
+    check(alb <= 1.0, "%s: Monte Carlo albedo %.5f (<= 1)", tag, alb);
+    check(fabs(alb - ialb) <= fmax(0.01 * ialb, 5.0 * sd) + 1e-6,
+          "%s: Monte Carlo albedo %.5f vs quadrature of f|cos| %.5f (within max(1%%, 5 sigma = "
+          "%.5f))",
+          tag, alb, ialb, 5.0 * sd);
+    if (is_phong && wo_deg == 0.0 && !tilted) {
+        /* At normal incidence the normalized lobe lies entirely above the
+         * surface and reflects exactly ks: the albedo is kd + ks. */
+        double want = mc->kd + mc->ks;
+        check(fabs(ialb - want) <= 1e-3 * want && fabs(alb - want) <= fmax(0.01 * want, 5.0 * sd),
+              "%s: albedo at normal incidence: quadrature %.5f, Monte Carlo %.5f vs kd + ks = %.5f",
+              tag, ialb, alb, want);
+    }
+    if (mc->type == CDL_MAT_DIFFUSE) {
+        double want = mc->kd * succ;
+        check(fabs(alb - want) <= 0.01 * want,
+              "%s: Lambert albedo %.5f vs kd * success rate %.5f (within 1%%)", tag, alb, want);
+    }
+
+    /* Reciprocity, pairs with wo and random pairs over the sphere. */
+    double max_rec = 0.0;
+    long nonzero = 0;
+    for (int s = 0; s < 20000; s++) {
+        float z = 2.0f * cdl_rng_float(&rng) - 1.0f, ph = 2.0f * CDL_PI * cdl_rng_float(&rng);
+        float rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        cdl_vec3 a = cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
+        cdl_vec3 bb = wo;
+        if (s & 1) {
+            z = 2.0f * cdl_rng_float(&rng) - 1.0f;
+            ph = 2.0f * CDL_PI * cdl_rng_float(&rng);
+            rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+            bb = cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
+        }
+        cdl_vec3 f1 = cdl_bsdf_eval(&b, bb, a), f2 = cdl_bsdf_eval(&b, a, bb);
+        if (!cdl_is_black(f1))
+            nonzero++;
+        max_rec = fmax(max_rec, rel_err(f1.x, f2.x));
+        max_rec = fmax(max_rec, rel_err(f1.y, f2.y));
+        max_rec = fmax(max_rec, rel_err(f1.z, f2.z));
+    }
+    check(max_rec <= 1e-4 && nonzero > 1000,
+          "%s: reciprocity f(wo,wi) = f(wi,wo): max relative error %.2e (<= 1e-4) over 20000 "
+          "pairs (%ld non-zero)",
+          tag, max_rec, nonzero);
+    printf("    (%ld quadrature evaluations)\n", g.evals);
+}
+
+/* ---- mirror ----------------------------------------------------------- */
+
+static void test_mirror(double wo_deg, int tilted, double tilt_az_deg)
+{
+    dvec ngd = geo_normal();
+    dframe gf = dframe_from(ngd);
+    dvec nsd = tilted ? polar(&gf, 10.0 * DEG, tilt_az_deg * DEG) : ngd;
+    dvec wod = polar(&gf, wo_deg * DEG, 0.0);
+    cdl_material m = make_material(CDL_MAT_MIRROR, 0.0f, 0.9f, 0.0f, 1.0f);
+    cdl_bsdf b;
+    cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
+    cdl_vec3 wo = to_f(wod);
+    char tag[160];
+    snprintf(tag, sizeof tag, "mirror ks=0.9 wo=%gdeg%s", wo_deg, wo_deg > 90.0 ? " (back side)" : "");
+    if (tilted)
+        snprintf(tag + strlen(tag), sizeof tag - strlen(tag), " ns tilted 10deg az %gdeg",
+                 tilt_az_deg);
+    dvec want = dsub(dscale(nsd, 2.0 * ddot(wod, nsd)), wod);
+    int want_ok = ddot(want, ngd) * ddot(wod, ngd) > 0.0;
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 0x3141ULL, (uint64_t)(wo_deg * 10.0) + (uint64_t)tilted * 7919u);
+    double max_dir = 0.0;
+    long wrong_ret = 0, wrong_misc = 0;
+    for (int s = 0; s < 1000; s++) {
+        cdl_scatter sc;
+        float u0 = cdl_rng_float(&rng), u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
+        int ok = cdl_bsdf_sample(&b, wo, u0, u1, u2, s & 1, &sc);
+        if (ok != want_ok)
+            wrong_ret++;
+        if (!ok)
+            continue;
+        dvec d = dsub(from_f(sc.wi), want);
+        max_dir = fmax(max_dir, sqrt(ddot(d, d)));
+        if (sc.weight.x != 0.9f || sc.weight.y != 0.9f || sc.weight.z != 0.9f || sc.pdf != 1.0f ||
+            !sc.delta)
+            wrong_misc++;
+    }
+    check(wrong_ret == 0, "%s: sample returns %d (reflection %s the geometric surface): %ld wrong",
+          tag, want_ok, want_ok ? "above" : "below", wrong_ret);
+    if (want_ok) {
+        check(max_dir <= 1e-5, "%s: |wi - reflect(wo, ns)| max %.2e (<= 1e-5)", tag, max_dir);
+        check(wrong_misc == 0, "%s: weight = ks, pdf = 1, delta = 1: %ld violations", tag,
+              wrong_misc);
+    }
+    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(want));
+    float p = cdl_bsdf_pdf(&b, wo, to_f(want));
+    check(cdl_is_black(f) && p == 0.0f, "%s: eval (%g) and pdf (%g) of a delta BSDF are 0", tag,
+          f.x, p);
+}
+
+/* ---- dielectric ----------------------------------------------------------- */
+
+/* Fresnel for unpolarized light in the angle form (independent of the
+ * library's): rs = -sin(ti - tt) / sin(ti + tt), rp = tan(ti - tt) / tan(ti + tt). */
+static double fresnel_ref(double ti, double eta_i, double eta_t)
+{
+    double st = eta_i / eta_t * sin(ti);
+    if (st >= 1.0)
+        return 1.0;
+    double tt = asin(st);
+    if (ti < 1e-9) {
+        double r = (eta_i - eta_t) / (eta_i + eta_t);
+        return r * r;
+    }
+    double rs = sin(ti - tt) / sin(ti + tt), rp = tan(ti - tt) / tan(ti + tt);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+#define NDIEL 100000
+
+static void test_dielectric(double theta_deg, int entering, int tilted)
+{
+    const float eta = 1.5f;
+    dvec ngd = geo_normal();
+    dframe gf = dframe_from(ngd);
+    dvec nsd = tilted ? polar(&gf, 10.0 * DEG, 40.0 * DEG) : ngd;
+    /* theta is measured from the normal on wo's side. */
+    dvec wod = polar(&gf, (entering ? theta_deg : 180.0 - theta_deg) * DEG, 0.0);
+    cdl_material m = make_material(CDL_MAT_DIELECTRIC, 0.0f, 0.0f, 0.0f, eta);
+    cdl_bsdf b;
+    cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
+    cdl_vec3 wo = to_f(wod);
+    double eta_i = entering ? 1.0 : eta, eta_t = entering ? eta : 1.0;
+    double eta_rel = eta_t / eta_i;
+    char tag[160];
+    snprintf(tag, sizeof tag, "dielectric eta=1.5 %s theta=%gdeg%s",
+             entering ? "entering (front)" : "exiting (back)", theta_deg,
+             tilted ? " ns tilted 10deg" : "");
+    /* Normal on wo's side, and the incidence angle to it. */
+    dvec nw = ddot(wod, ngd) > 0.0 ? nsd : dscale(nsd, -1.0);
+    double cos_i = ddot(wod, nw), th_i = acos(fmin(1.0, cos_i));
+    double fref = fresnel_ref(th_i, eta_i, eta_t);
+    float flib = cdl_fresnel_dielectric((float)cos_i, (float)eta_rel);
+    float flib2 = cdl_fresnel_dielectric((float)-cos_i, (float)(1.0 / eta_rel));
+    check(fabs(flib - fref) <= 1e-5 && flib == flib2,
+          "%s: cdl_fresnel_dielectric %.6f (also with cos < 0: %.6f) vs angle-form Fresnel "
+          "%.6f (|diff| <= 1e-5)",
+          tag, flib, flib2, fref);
+    double sin_i = sin(th_i), sin_t = eta_i / eta_t * sin_i;
+    int tir = sin_t >= 1.0;
+    if (tir)
+        check(flib == 1.0f, "%s: beyond the critical angle %.2fdeg: F = %g (1)", tag,
+              asin(eta_t / eta_i) / DEG, flib);
+    dvec refl = dsub(dscale(nw, 2.0 * cos_i), wod);
+    dvec trans = dv(0, 0, 0);
+    if (!tir) {
+        double cos_t = sqrt(1.0 - sin_t * sin_t);
+        trans = dsub(dscale(dscale(wod, -1.0), 1.0 / eta_rel), dscale(nw, cos_t - cos_i / eta_rel));
+    }
+    dvec perp = dcross(wod, nw);
+    double perp_len = sqrt(ddot(perp, perp));
+
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 0xd1e1ULL, (uint64_t)(theta_deg * 10.0) * 4u + (uint64_t)entering * 2u +
+                                     (uint64_t)tilted);
+    long ntrans = 0, fails = 0, bad_w = 0, bad_pdf = 0, bad_delta = 0;
+    double max_refl = 0.0, max_trans = 0.0, max_snell = 0.0, max_plane = 0.0, max_unit = 0.0;
+    double pdf_r = -1.0, pdf_t = -1.0; /* discrete probabilities of the two events */
+    for (int adjoint = 0; adjoint < 2; adjoint++) {
+        long nr = 0;
+        for (int s = 0; s < NDIEL; s++) {
+            cdl_scatter sc;
+            float u0 = cdl_rng_float(&rng), u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
+            if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, adjoint, &sc)) {
+                fails++;
+                continue;
+            }
+            if (!sc.delta)
+                bad_delta++;
+            dvec wi = from_f(sc.wi);
+            max_unit = fmax(max_unit, fabs(sqrt(ddot(wi, wi)) - 1.0));
+            if (ddot(wi, ngd) * ddot(wod, ngd) > 0.0) {
+                nr++;
+                dvec d = dsub(wi, refl);
+                max_refl = fmax(max_refl, sqrt(ddot(d, d)));
+                if (sc.weight.x != 1.0f || sc.weight.y != 1.0f || sc.weight.z != 1.0f)
+                    bad_w++;
+                if (pdf_r < 0.0)
+                    pdf_r = sc.pdf;
+                if (sc.pdf != pdf_r)
+                    bad_pdf++;
+            } else {
+                ntrans++;
+                if (!tir) {
+                    dvec d = dsub(wi, trans);
+                    max_trans = fmax(max_trans, sqrt(ddot(d, d)));
+                }
+                /* Snell: eta_i sin_i = eta_t sin_t, measured on the sample. */
+                double ct = -ddot(wi, nw);
+                double st = sqrt(fmax(0.0, 1.0 - ct * ct));
+                max_snell = fmax(max_snell, fabs(eta_i * sin_i - eta_t * st));
+                if (perp_len > 1e-6)
+                    max_plane = fmax(max_plane, fabs(ddot(wi, perp)) / perp_len);
+                double want_w = adjoint ? 1.0 : 1.0 / (eta_rel * eta_rel);
+                if (rel_err(sc.weight.x, want_w) > 1e-6 || sc.weight.x != sc.weight.y ||
+                    sc.weight.x != sc.weight.z)
+                    bad_w++;
+                if (pdf_t < 0.0)
+                    pdf_t = sc.pdf;
+                if (sc.pdf != pdf_t)
+                    bad_pdf++;
+            }
+        }
+        double freq = (double)nr / NDIEL;
+        double sd = sqrt(fmax(flib * (1.0 - flib), 1e-12) / NDIEL);
+        check(fabs(freq - flib) <= 0.01 && fabs(freq - flib) <= 5.0 * sd + 1e-12,
+              "%s adjoint=%d: reflection frequency %.5f vs Fresnel %.5f (|diff| %.5f <= 0.01 and "
+              "<= 5 sigma = %.5f)",
+              tag, adjoint, freq, flib, fabs(freq - flib), 5.0 * sd);
+    }
+    check(fails == 0 && bad_delta == 0, "%s: failed samples %ld, non-delta samples %ld (0)", tag,
+          fails, bad_delta);
+    check(max_refl <= 1e-5, "%s: reflected wi vs reflect(wo, n): max |diff| %.2e (<= 1e-5)", tag,
+          max_refl);
+    check(max_unit <= 1e-5, "%s: max ||wi| - 1| %.2e (<= 1e-5)", tag, max_unit);
+    if (tir) {
+        check(ntrans == 0, "%s: total internal reflection: %ld refracted samples (0)", tag, ntrans);
+    } else {
+        check(ntrans > 0 && max_trans <= 1e-5,
+              "%s: refracted wi vs Snell direction: max |diff| %.2e (<= 1e-5, %ld samples)", tag,
+              max_trans, ntrans);
+        check(max_snell <= 1e-5,
+              "%s: sin ratio: max |eta_i sin_i - eta_t sin_t| %.2e (<= 1e-5; sin_i %.5f, "
+              "sin_t %.5f)",
+              tag, max_snell, sin_i, sin_t);
+        if (perp_len > 1e-6)
+            check(max_plane <= 1e-5, "%s: refracted wi in the plane of incidence: max %.2e (<= 1e-5)",
+                  tag, max_plane);
+    }
+    check(bad_w == 0, "%s: weights (reflection 1; refraction 1/eta^2 = %.5f radiance, 1 "
+                      "importance): %ld violations",
+          tag, 1.0 / (eta_rel * eta_rel), bad_w);
+    /* The sampler computes cos_o from the float wo and shading normal: its
+     * F may differ from ours by a few ulps times dF/dcos. */
+    double pr = pdf_r < 0.0 ? 0.0 : pdf_r, pt = pdf_t < 0.0 ? 0.0 : pdf_t;
+    check(bad_pdf == 0 && fabs(pr - flib) <= 1e-4 && (pdf_r < 0.0 || pdf_t < 0.0 || fabs(pr + pt - 1.0) <= 1e-6),
+          "%s: pdf of reflection %.6f (F = %.6f within 1e-4), of refraction %.6f (sum 1 within "
+          "1e-6), %ld samples with another pdf",
+          tag, pr, flib, pt, bad_pdf);
+    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(refl));
+    float p = cdl_bsdf_pdf(&b, wo, to_f(refl));
+    check(cdl_is_black(f) && p == 0.0f, "%s: eval (%g) and pdf (%g) of a delta BSDF are 0", tag,
+          f.x, p);
+}
+
+static void test_fresnel(void)
+{
+    float f0 = cdl_fresnel_dielectric(1.0f, 1.5f), f1 = cdl_fresnel_dielectric(1.0f, 1.0f / 1.5f);
+    float f2 = cdl_fresnel_dielectric(-1.0f, 1.5f);
+    double want = (0.5 / 2.5) * (0.5 / 2.5);
+    check(fabs(f0 - want) < 1e-6 && fabs(f1 - want) < 1e-6 && fabs(f2 - want) < 1e-6,
+          "fresnel at normal incidence: %.7f entering, %.7f exiting, %.7f (cos < 0) vs "
+          "((eta-1)/(eta+1))^2 = %.7f",
+          f0, f1, f2, want);
+    /* Reciprocity: the same interface seen from both sides. */
+    double worst = 0.0;
+    for (int i = 1; i < 90; i++) {
+        double ti = i * DEG, tt = asin(sin(ti) / 1.5);
+        double a = cdl_fresnel_dielectric((float)cos(ti), 1.5f);
+        double bb = cdl_fresnel_dielectric((float)cos(tt), 1.0f / 1.5f);
+        worst = fmax(worst, fabs(a - bb));
+    }
+    /* Near grazing ti the exiting side sits near its critical angle, where
+     * cos_t = sqrt(1 - sin2_t) loses float digits: 1e-4, not 1e-6. */
+    check(worst <= 1e-4,
+          "fresnel reciprocity F(ti, 1.5) = F(tt, 1/1.5), ti = 1..89deg: max |diff| %.2e (<= 1e-4)",
+          worst);
+    float g = cdl_fresnel_dielectric(cosf(60.0f * CDL_PI / 180.0f), 1.0f / 1.5f);
+    check(g == 1.0f, "fresnel exiting glass at 60deg (critical 41.81deg): %g (1)", g);
+}
+
+static void test_init(void)
+{
+    /* A shading normal on the far side of ng (flipped winding) is flipped. */
+    dvec ngd = geo_normal();
+    dframe gf = dframe_from(ngd);
+    dvec nsd = polar(&gf, 170.0 * DEG, 40.0 * DEG);
+    cdl_material m = make_material(CDL_MAT_DIFFUSE, 0.8f, 0.0f, 0.0f, 1.0f);
+    cdl_bsdf b;
+    cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
+    double d = ddot(from_f(b.frame.n), ngd), e = ddot(from_f(b.frame.n), dscale(nsd, -1.0));
+    check(d > 0.0 && e > 1.0 - 1e-6,
+          "bsdf_init with ns on the back of ng: frame.n . ng = %.5f (> 0), frame.n . -ns = %.7f (1)",
+          d, e);
+    double orth = fmax(fabs(cdl_dot(b.frame.t, b.frame.b)),
+                       fmax(fabs(cdl_dot(b.frame.t, b.frame.n)), fabs(cdl_dot(b.frame.b, b.frame.n))));
+    check(orth < 1e-6, "bsdf_init shading frame orthonormal: max |dot| %.2e (< 1e-6)", orth);
+}
+
+int main(void)
+{
+    test_gamma();
+    test_init();
+
+    static const opaque_case cases[] = {
+        {"lambert kd=0.8", CDL_MAT_DIFFUSE, 0.8f, 0.0f, 0.0f},
+        {"phong kd=0.3 ks=0.6 n=1", CDL_MAT_PHONG, 0.3f, 0.6f, 1.0f},
+        {"phong kd=0.3 ks=0.6 n=10", CDL_MAT_PHONG, 0.3f, 0.6f, 10.0f},
+        {"phong kd=0.3 ks=0.6 n=100", CDL_MAT_PHONG, 0.3f, 0.6f, 100.0f},
+        {"phong kd=0.3 ks=0.6 n=1000", CDL_MAT_PHONG, 0.3f, 0.6f, 1000.0f},
+        {"phong kd=0 ks=0.9 n=30", CDL_MAT_PHONG, 0.0f, 0.9f, 30.0f},
+    };
+    /* Angles from ng: > 90 is on the back side (135 = 45deg, 95 = 85deg). */
+    static const double wos[] = {0.0, 30.0, 60.0, 85.0, 135.0, 95.0};
+    uint64_t stream = 0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
+        for (int tilted = 0; tilted < 2; tilted++)
+            for (size_t w = 0; w < sizeof wos / sizeof wos[0]; w++)
+                test_opaque(&cases[c], wos[w], tilted, stream++);
+
+    static const double mw[] = {0.0, 30.0, 60.0, 85.0, 135.0, 95.0};
+    for (size_t w = 0; w < sizeof mw / sizeof mw[0]; w++)
+        test_mirror(mw[w], 0, 0.0);
+    test_mirror(30.0, 1, 40.0);
+    test_mirror(135.0, 1, 40.0);
+    test_mirror(85.0, 1, 180.0); /* reflection about ns dips below the surface */
+
+    test_fresnel();
+    static const double ent[] = {0.0, 30.0, 60.0, 85.0};
+    static const double ext[] = {0.0, 30.0, 40.0, 45.0, 60.0, 85.0};
+    for (size_t i = 0; i < sizeof ent / sizeof ent[0]; i++)
+        test_dielectric(ent[i], 1, 0);
+    for (size_t i = 0; i < sizeof ext / sizeof ext[0]; i++)
+        test_dielectric(ext[i], 0, 0);
+    test_dielectric(30.0, 1, 1);
+    test_dielectric(30.0, 0, 1);
+
+    check(chi2_count == N_CHI2, "%d chi-square tests run (N_CHI2 = %d, for the Sidak correction)",
+          chi2_count, N_CHI2);
+    printf("%d checks, %d failures\n", checks, failures);
+    return failures ? 1 : 0;
+}
