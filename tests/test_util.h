@@ -20,7 +20,7 @@ static int test_failures = 0;
             test_failures++;                                                                       \
     } while (0)
 
-static void die_on(int rc, const cdl_error *err)
+static inline void die_on(int rc, const cdl_error *err)
 {
     if (rc) {
         char buf[2048];
@@ -31,7 +31,7 @@ static void die_on(int rc, const cdl_error *err)
 }
 
 /* Renders passes [0, npass) of `integrator` into a new film. */
-static void render_film(const char *integrator, const cdl_scene *s, const cdl_options *opt,
+static inline void render_film(const char *integrator, const cdl_scene *s, const cdl_options *opt,
                         int w, int h, uint32_t npass, cdl_film *film)
 {
     cdl_error err;
@@ -44,7 +44,7 @@ static void render_film(const char *integrator, const cdl_scene *s, const cdl_op
     cdl_integrator_destroy(&it);
 }
 
-static double film_pixel(const cdl_film *f, int x, int y, int c)
+static inline double film_pixel(const cdl_film *f, int x, int y, int c)
 {
     size_t i = (size_t)y * (size_t)f->width + (size_t)x;
     return f->sum[3 * i + c] / f->count[i];
