@@ -18,10 +18,11 @@ static void build_sphere(cdl_scene *s, int nth, int nph, float albedo, float le)
     memset(&m, 0, sizeof m);
     m.type = CDL_MAT_DIFFUSE;
     m.kd = cdl_v3(albedo, albedo, albedo);
-    m.ke = cdl_v3(le, le, le);
     m.kd_tex = -1;
     uint32_t mid, first;
+    int32_t emit;
     die_on(cdl_scene_add_material(s, &m, &mid, &err), &err);
+    die_on(cdl_scene_add_emitter(s, cdl_v3(le, le, le), 0, &emit, &err), &err);
     int nv = (nth + 1) * (nph + 1);
     float *p = malloc(sizeof(float) * 3 * (size_t)nv);
     for (int i = 0; i <= nth; i++)
@@ -39,8 +40,8 @@ static void build_sphere(cdl_scene *s, int nth, int nph, float albedo, float le)
             uint32_t a = first + (uint32_t)(i * (nph + 1) + j), b = a + 1;
             uint32_t c = a + (uint32_t)(nph + 1), d = c + 1;
             /* (a, b, c) would face outwards */
-            die_on(cdl_scene_add_triangle(s, a, c, b, mid, 0, &err), &err);
-            die_on(cdl_scene_add_triangle(s, b, c, d, mid, 0, &err), &err);
+            die_on(cdl_scene_add_triangle(s, a, c, b, mid, emit, 0, &err), &err);
+            die_on(cdl_scene_add_triangle(s, b, c, d, mid, emit, 0, &err), &err);
         }
     die_on(cdl_scene_commit(s, &err), &err);
 }
@@ -95,8 +96,8 @@ static void plane(const char *integ)
     die_on(cdl_scene_add_material(&s, &m, &mid, &err), &err);
     float p[12] = {-10, 0, -10, 10, 0, -10, 10, 0, 10, -10, 0, 10};
     die_on(cdl_scene_add_vertices(&s, 4, p, NULL, NULL, &first, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 1, mid, 0, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 3, first + 2, mid, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 1, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 3, first + 2, mid, -1, 0, &err), &err);
     cdl_vec3 lp = cdl_v3(0.3f, h, -0.2f);
     die_on(cdl_scene_add_point_light(&s, lp, cdl_v3(I, I, I), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);

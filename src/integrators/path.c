@@ -43,12 +43,26 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
         return f;
     cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
     (*rays)++;
-    if (cdl_occluded(s, o, ls.wi, ls.dist * (1.0f - 1e-4f)))
+    if (cdl_occluded(s, o, ls.wi, ls.dist < FLT_MAX ? ls.dist * (1.0f - 1e-4f) : FLT_MAX))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float pdf_l = ls.pdf * pmf;
     float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
     float w = ls.delta ? 1.0f : cdl_power_heuristic(pdf_l, cdl_bsdf_pdf(b, wo, ls.wi));
     return cdl_scale(cdl_mul(f, ls.Li), cos * w / pdf_l);
+}
+
+/* Emission found by following the path (an area light hit, or the
+ * infinite light on escape), MIS-weighted against light sampling unless
+ * the last bounce was specular. */
+static cdl_vec3 emitted(const cdl_scene *s, int32_t light, cdl_vec3 o, cdl_vec3 d, float t,
+                        cdl_vec3 ng, int specular, float pdf_prev)
+{
+    const cdl_light *l = &s->lights[light];
+    cdl_vec3 Le = l->type == CDL_LIGHT_INFINITE ? l->L : cdl_light_Le(l, ng, cdl_neg(d));
+    if (specular || cdl_is_black(Le))
+        return Le;
+    float pdf_l = s->light_select.pmf[light] * cdl_light_pdf_li(l, o, d, t);
+    return cdl_scale(Le, cdl_power_heuristic(pdf_prev, pdf_l));
 }
 
 static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampler *smp,
@@ -61,21 +75,17 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
     for (int depth = 0;; depth++) {
         cdl_hit h;
         (*rays)++;
-        if (!cdl_intersect(s, o, d, FLT_MAX, &h))
+        if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
+            if (s->env_light >= 0)
+                L = cdl_add(L, cdl_mul(beta, emitted(s, s->env_light, o, d, FLT_MAX,
+                                                     cdl_neg(d), specular, pdf_prev)));
             break;
+        }
         cdl_surface sf;
         cdl_surface_at(s, &h, &sf);
         cdl_vec3 wo = cdl_neg(d);
-        if (sf.light >= 0 && cdl_dot(wo, sf.ng) > 0.0f) {
-            const cdl_light *l = &s->lights[sf.light];
-            float w = 1.0f;
-            if (!specular) {
-                float pdf_l = s->light_select.pmf[sf.light] * h.t * h.t /
-                              (cdl_dot(wo, sf.ng) * l->area);
-                w = cdl_power_heuristic(pdf_prev, pdf_l);
-            }
-            L = cdl_add(L, cdl_scale(cdl_mul(beta, l->L), w));
-        }
+        if (sf.light >= 0)
+            L = cdl_add(L, cdl_mul(beta, emitted(s, sf.light, o, d, h.t, sf.ng, specular, pdf_prev)));
         if (depth >= ps->opt.maxdepth)
             break;
         cdl_bsdf b;

@@ -1,11 +1,73 @@
 #include "scene/light.h"
 
+#include <float.h>
+
 #include "core/sampling.h"
+
+/* pbrt-v3's spot falloff: smooth fourth power between the two cones. */
+static float spot_falloff(const cdl_light *l, float cos_t)
+{
+    if (cos_t < l->cos_total)
+        return 0.0f;
+    if (cos_t >= l->cos_falloff)
+        return 1.0f;
+    float d = (cos_t - l->cos_total) / (l->cos_falloff - l->cos_total);
+    return (d * d) * (d * d);
+}
+
+static int sample_sphere(const cdl_light *l, cdl_vec3 ref, float u1, float u2, cdl_light_sample *s)
+{
+    cdl_vec3 dc = cdl_sub(l->p, ref);
+    float d2 = cdl_dot(dc, dc), r2 = l->radius * l->radius;
+    if (d2 <= r2 * 1.0001f) {
+        /* inside (or on) the sphere: uniform on the surface */
+        cdl_vec3 n = cdl_sample_uniform_sphere(u1, u2);
+        s->p = cdl_madd(l->p, n, l->radius);
+        cdl_vec3 d = cdl_sub(s->p, ref);
+        float dd = cdl_dot(d, d);
+        if (!(dd > 0.0f))
+            return 0;
+        s->dist = sqrtf(dd);
+        s->wi = cdl_scale(d, 1.0f / s->dist);
+        float c = fabsf(cdl_dot(n, s->wi));
+        if (!(c > 0.0f))
+            return 0;
+        s->pdf = dd / (c * l->area);
+        s->Li = cdl_light_Le(l, n, cdl_neg(s->wi));
+        s->delta = 0;
+        return !cdl_is_black(s->Li);
+    }
+    /* outside: uniform in the cone the sphere subtends (pbrt-v3 Sphere::Sample) */
+    float dist_c = sqrtf(d2);
+    cdl_vec3 wc = cdl_scale(dc, 1.0f / dist_c);
+    float sin2_max = r2 / d2;
+    float cos_max = sqrtf(cdl_maxf(0.0f, 1.0f - sin2_max));
+    float cos_t = (1.0f - u1) + u1 * cos_max;
+    float sin_t2 = cdl_maxf(0.0f, 1.0f - cos_t * cos_t);
+    float phi = 2.0f * CDL_PI * u2;
+    float ds = dist_c * cos_t - sqrtf(cdl_maxf(0.0f, r2 - d2 * sin_t2));
+    float cos_a = (d2 + r2 - ds * ds) / (2.0f * dist_c * l->radius);
+    float sin_a = sqrtf(cdl_maxf(0.0f, 1.0f - cos_a * cos_a));
+    cdl_frame f = cdl_frame_from(cdl_neg(wc));
+    cdl_vec3 n = cdl_to_world(&f, cdl_v3(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
+    s->p = cdl_madd(l->p, n, l->radius);
+    cdl_vec3 d = cdl_sub(s->p, ref);
+    s->dist = cdl_length(d);
+    if (!(s->dist > 0.0f))
+        return 0;
+    s->wi = cdl_scale(d, 1.0f / s->dist);
+    s->pdf = 1.0f / (2.0f * CDL_PI * (1.0f - cos_max));
+    s->Li = cdl_light_Le(l, n, cdl_neg(s->wi));
+    s->delta = 0;
+    return !cdl_is_black(s->Li) && isfinite(s->pdf);
+}
 
 int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
                         cdl_light_sample *s)
 {
-    if (l->type == CDL_LIGHT_POINT) {
+    switch (l->type) {
+    case CDL_LIGHT_POINT:
+    case CDL_LIGHT_SPOT: {
         cdl_vec3 d = cdl_sub(l->p, ref);
         float d2 = cdl_dot(d, d);
         if (!(d2 > 0.0f))
@@ -13,10 +75,32 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
         s->dist = sqrtf(d2);
         s->wi = cdl_scale(d, 1.0f / s->dist);
         s->p = l->p;
-        s->Li = cdl_scale(l->L, 1.0f / d2);
+        float fall = l->type == CDL_LIGHT_SPOT ? spot_falloff(l, -cdl_dot(s->wi, l->n)) : 1.0f;
+        s->Li = cdl_scale(l->L, fall / d2);
+        s->pdf = 1.0f;
+        s->delta = 1;
+        return fall > 0.0f;
+    }
+    case CDL_LIGHT_DISTANT:
+        s->wi = cdl_neg(l->n);
+        s->dist = FLT_MAX;
+        s->p = cdl_madd(ref, s->wi, 2.0f * l->radius);
+        s->Li = l->L;
         s->pdf = 1.0f;
         s->delta = 1;
         return 1;
+    case CDL_LIGHT_INFINITE:
+        s->wi = cdl_sample_uniform_sphere(u1, u2);
+        s->dist = FLT_MAX;
+        s->p = cdl_madd(ref, s->wi, 2.0f * l->radius);
+        s->Li = l->L;
+        s->pdf = 0.25f * CDL_INV_PI;
+        s->delta = 0;
+        return 1;
+    case CDL_LIGHT_SPHERE:
+        return sample_sphere(l, ref, u1, u2, s);
+    case CDL_LIGHT_TRIANGLE:
+        break;
     }
     float b1, b2;
     cdl_sample_triangle(u1, u2, &b1, &b2);
@@ -28,6 +112,8 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
     s->dist = sqrtf(d2);
     s->wi = cdl_scale(d, 1.0f / s->dist);
     float cos_l = -cdl_dot(s->wi, l->n);
+    if (l->twosided)
+        cos_l = fabsf(cos_l);
     if (cos_l <= 0.0f)
         return 0; /* receiver behind the emitting face */
     s->Li = l->L;
@@ -36,46 +122,140 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
     return 1;
 }
 
-float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 p)
+float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist)
 {
-    if (l->type == CDL_LIGHT_POINT)
+    switch (l->type) {
+    case CDL_LIGHT_TRIANGLE: {
+        float cos_l = -cdl_dot(wi, l->n);
+        if (l->twosided)
+            cos_l = fabsf(cos_l);
+        return cos_l > 0.0f ? dist * dist / (cos_l * l->area) : 0.0f;
+    }
+    case CDL_LIGHT_SPHERE: {
+        cdl_vec3 dc = cdl_sub(l->p, ref);
+        float d2 = cdl_dot(dc, dc), r2 = l->radius * l->radius;
+        if (d2 <= r2 * 1.0001f) {
+            cdl_vec3 n = cdl_normalize(cdl_sub(cdl_madd(ref, wi, dist), l->p));
+            float c = fabsf(cdl_dot(n, wi));
+            return c > 0.0f ? dist * dist / (c * l->area) : 0.0f;
+        }
+        float cos_max = sqrtf(cdl_maxf(0.0f, 1.0f - r2 / d2));
+        return 1.0f / (2.0f * CDL_PI * (1.0f - cos_max));
+    }
+    case CDL_LIGHT_INFINITE:
+        return 0.25f * CDL_INV_PI;
+    default:
         return 0.0f;
-    cdl_vec3 d = cdl_sub(p, ref);
-    float d2 = cdl_dot(d, d);
-    float cos_l = -cdl_dot(d, l->n) / sqrtf(d2);
-    return cos_l > 0.0f ? d2 / (cos_l * l->area) : 0.0f;
+    }
+}
+
+cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo)
+{
+    float c = cdl_dot(ng, wo);
+    int front = l->type == CDL_LIGHT_SPHERE ? (l->inward ? c < 0.0f : c > 0.0f)
+                                            : (l->twosided ? c != 0.0f : c > 0.0f);
+    return front ? l->L : cdl_v3(0.0f, 0.0f, 0.0f);
 }
 
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,
                         cdl_light_emit *e)
 {
-    if (l->type == CDL_LIGHT_POINT) {
+    switch (l->type) {
+    case CDL_LIGHT_POINT:
+    case CDL_LIGHT_SPOT:
         e->p = l->p;
         e->n = cdl_v3(0.0f, 0.0f, 0.0f);
-        e->d = cdl_sample_uniform_sphere(u3, u4);
-        e->Le = l->L;
         e->pdf_pos = 1.0f;
-        e->pdf_dir = 0.25f * CDL_INV_PI;
+        if (l->type == CDL_LIGHT_POINT) {
+            e->d = cdl_sample_uniform_sphere(u3, u4);
+            e->pdf_dir = 0.25f * CDL_INV_PI;
+            e->Le = l->L;
+        } else {
+            /* uniform in the outer cone */
+            float cos_t = 1.0f - u3 * (1.0f - l->cos_total);
+            float sin_t = sqrtf(cdl_maxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * CDL_PI * u4;
+            cdl_frame f = cdl_frame_from(l->n);
+            e->d = cdl_to_world(&f, cdl_v3(sin_t * cosf(phi), sin_t * sinf(phi), cos_t));
+            e->pdf_dir = 1.0f / (2.0f * CDL_PI * (1.0f - l->cos_total));
+            e->Le = cdl_scale(l->L, spot_falloff(l, cos_t));
+        }
         return 1;
+    case CDL_LIGHT_DISTANT:
+    case CDL_LIGHT_INFINITE: {
+        /* a ray entering the scene's bounding sphere: a disk perpendicular
+         * to the direction, pushed out to the sphere */
+        float pdf_dir = 1.0f;
+        if (l->type == CDL_LIGHT_DISTANT) {
+            e->d = l->n;
+        } else {
+            e->d = cdl_sample_uniform_sphere(u3, u4);
+            pdf_dir = 0.25f * CDL_INV_PI;
+        }
+        cdl_frame f = cdl_frame_from(e->d);
+        cdl_vec3 disk = cdl_sample_cosine_hemisphere(u1, u2); /* x, y uniform on the unit disk */
+        e->p = cdl_add(l->p, cdl_scale(cdl_add(cdl_scale(f.t, disk.x), cdl_scale(f.b, disk.y)), l->radius));
+        e->p = cdl_madd(e->p, e->d, -l->radius);
+        e->n = e->d;
+        e->Le = l->L;
+        e->pdf_pos = 1.0f / (CDL_PI * l->radius * l->radius);
+        e->pdf_dir = pdf_dir;
+        return 1;
+    }
+    case CDL_LIGHT_SPHERE: {
+        cdl_vec3 n = cdl_sample_uniform_sphere(u1, u2);
+        e->p = cdl_madd(l->p, n, l->radius);
+        e->n = l->inward ? cdl_neg(n) : n;
+        cdl_frame f = cdl_frame_from(e->n);
+        cdl_vec3 local = cdl_sample_cosine_hemisphere(u3, u4);
+        if (local.z <= 0.0f)
+            return 0;
+        e->d = cdl_to_world(&f, local);
+        e->Le = l->L;
+        e->pdf_pos = 1.0f / l->area;
+        e->pdf_dir = local.z * CDL_INV_PI;
+        return 1;
+    }
+    case CDL_LIGHT_TRIANGLE:
+        break;
     }
     float b1, b2;
     cdl_sample_triangle(u1, u2, &b1, &b2);
     e->p = cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
     e->n = l->n;
-    cdl_frame f = cdl_frame_from(l->n);
-    cdl_vec3 local = cdl_sample_cosine_hemisphere(u3, u4);
+    float side = 1.0f, pick = u3;
+    if (l->twosided) {
+        /* choose a face with probability 1/2, reusing u3 */
+        side = u3 < 0.5f ? 1.0f : -1.0f;
+        pick = u3 < 0.5f ? 2.0f * u3 : 2.0f * u3 - 1.0f;
+        e->n = cdl_scale(l->n, side);
+    }
+    cdl_frame f = cdl_frame_from(e->n);
+    cdl_vec3 local = cdl_sample_cosine_hemisphere(pick, u4);
     if (local.z <= 0.0f)
         return 0;
     e->d = cdl_to_world(&f, local);
     e->Le = l->L;
     e->pdf_pos = 1.0f / l->area;
-    e->pdf_dir = local.z * CDL_INV_PI;
+    e->pdf_dir = local.z * CDL_INV_PI * (l->twosided ? 0.5f : 1.0f);
     return 1;
 }
 
 cdl_vec3 cdl_light_power(const cdl_light *l)
 {
-    if (l->type == CDL_LIGHT_POINT)
+    switch (l->type) {
+    case CDL_LIGHT_POINT:
         return cdl_scale(l->L, 4.0f * CDL_PI);
-    return cdl_scale(l->L, CDL_PI * l->area);
+    case CDL_LIGHT_SPOT:
+        return cdl_scale(l->L, 2.0f * CDL_PI * (1.0f - 0.5f * (l->cos_falloff + l->cos_total)));
+    case CDL_LIGHT_DISTANT:
+        return cdl_scale(l->L, CDL_PI * l->radius * l->radius);
+    case CDL_LIGHT_INFINITE:
+        return cdl_scale(l->L, 4.0f * CDL_PI * CDL_PI * l->radius * l->radius);
+    case CDL_LIGHT_SPHERE:
+        return cdl_scale(l->L, CDL_PI * l->area);
+    case CDL_LIGHT_TRIANGLE:
+        break;
+    }
+    return cdl_scale(l->L, CDL_PI * l->area * (l->twosided ? 2.0f : 1.0f));
 }

@@ -1,6 +1,8 @@
-/* Lights: triangle area lights (emissive MTL materials, front face only)
- * and point lights. One interface for next-event estimation (sample a
- * point towards a receiver) and for light paths (sample an emitted ray). */
+/* Lights, behind one interface for next-event estimation (sample a point
+ * towards a receiver, and its density) and for light paths (sample an
+ * emitted ray). Area lights are triangles and analytic spheres; point and
+ * spot lights are delta in position, distant lights in direction; the
+ * infinite light is constant radiance from all directions. */
 #ifndef CDL_LIGHT_H
 #define CDL_LIGHT_H
 
@@ -8,39 +10,61 @@
 
 #include "core/vec.h"
 
-typedef enum cdl_light_type { CDL_LIGHT_TRIANGLE, CDL_LIGHT_POINT } cdl_light_type;
+typedef enum cdl_light_type {
+    CDL_LIGHT_TRIANGLE,
+    CDL_LIGHT_SPHERE,
+    CDL_LIGHT_POINT,
+    CDL_LIGHT_SPOT,
+    CDL_LIGHT_DISTANT,
+    CDL_LIGHT_INFINITE
+} cdl_light_type;
 
 typedef struct cdl_light {
     cdl_light_type type;
-    cdl_vec3 p;      /* triangle vertex 0, or the point light's position */
+    cdl_vec3 p;      /* triangle vertex 0; sphere centre; point/spot position;
+                        distant/infinite: centre of the scene's bounding sphere */
     cdl_vec3 e1, e2; /* triangle edges p1 - p0, p2 - p0 */
-    cdl_vec3 n;      /* triangle front (CCW) unit normal */
-    float area;
-    cdl_vec3 L;      /* radiance (triangle) or intensity in W/sr (point) */
-    uint32_t prim;   /* triangle index in the scene */
+    cdl_vec3 n;      /* triangle front (CCW) unit normal; spot axis; distant:
+                        unit direction the light travels in */
+    float area;      /* triangle or sphere surface area */
+    float radius;    /* sphere radius; distant/infinite: scene bounding radius */
+    float cos_total, cos_falloff; /* spot cone (pbrt-v3 falloff) */
+    cdl_vec3 L;      /* radiance (area, distant, infinite) or intensity W/sr (point, spot) */
+    int twosided;    /* triangle: emits from both faces */
+    int inward;      /* sphere: emits towards its inside (ReverseOrientation) */
+    uint32_t prim;   /* triangle or sphere index in the scene */
 } cdl_light;
 
 typedef struct cdl_light_sample {
-    cdl_vec3 p;    /* point on the light */
+    cdl_vec3 p;    /* point on the light (far away for distant/infinite) */
     cdl_vec3 wi;   /* unit direction from the receiver to p */
-    float dist;    /* distance receiver to p */
-    cdl_vec3 Li;   /* radiance (area) or intensity / dist^2 (point) arriving */
+    float dist;    /* distance receiver to p; shadow rays go up to it */
+    cdl_vec3 Li;   /* radiance (area, infinite), intensity / dist^2 (point, spot), radiance (distant) */
     float pdf;     /* solid angle density at the receiver; 1 for delta lights */
     int delta;
 } cdl_light_sample;
 
 typedef struct cdl_light_emit {
     cdl_vec3 p, n, d; /* origin, normal there (0 for points), direction */
-    cdl_vec3 Le;      /* radiance (area) or intensity (point) along d */
+    cdl_vec3 Le;      /* radiance (area, distant, infinite) or intensity (point, spot) along d */
     float pdf_pos;    /* area density of p (1 for points) */
-    float pdf_dir;    /* solid angle density of d */
+    float pdf_dir;    /* solid angle density of d (1 for distant) */
 } cdl_light_emit;
 
-/* Returns 0 if the sample carries no light (back face, degenerate). */
+static inline int cdl_light_is_delta(const cdl_light *l)
+{
+    return l->type == CDL_LIGHT_POINT || l->type == CDL_LIGHT_SPOT || l->type == CDL_LIGHT_DISTANT;
+}
+
+/* Returns 0 if the sample carries no light (back face, outside a cone). */
 int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
                         cdl_light_sample *s);
-/* Solid-angle density of cdl_light_sample_li choosing point p (area lights). */
-float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 p);
+/* Solid-angle density of cdl_light_sample_li choosing direction wi that
+ * reaches the light at distance dist (area and infinite lights; 0 for delta). */
+float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist);
+/* Radiance an area light emits at a point with geometric normal ng
+ * towards direction wo; 0 from a back face. */
+cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo);
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,
                         cdl_light_emit *e);
 /* Emitted flux (RGB), for power-proportional light selection. */

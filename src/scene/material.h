@@ -1,26 +1,48 @@
-/* Materials as stored in the scene (one per MTL `newmtl`), before any
- * texture lookup; cdl_bsdf (bsdf.h) is a material evaluated at a hit. */
+/* Materials as stored in the scene (an MTL `newmtl`, a pbrt `Material`),
+ * before any texture lookup; cdl_bsdf (bsdf.h) is a material evaluated at
+ * a hit. Emission is not a material property: see cdl_scene_add_emitter. */
 #ifndef CDL_MATERIAL_H
 #define CDL_MATERIAL_H
 
 #include "core/vec.h"
 
 typedef enum cdl_mat_type {
-    CDL_MAT_DIFFUSE,   /* Lambert: Kd */
-    CDL_MAT_PHONG,     /* Lambert Kd + normalized Phong lobe Ks, exponent Ns */
-    CDL_MAT_MIRROR,    /* ideal specular reflection, reflectance Ks */
-    CDL_MAT_DIELECTRIC /* smooth glass, index eta */
+    CDL_MAT_DIFFUSE,         /* Lambert: kd */
+    CDL_MAT_PHONG,           /* Lambert kd + normalized Phong lobe ks, exponent ns (MTL) */
+    CDL_MAT_MIRROR,          /* ideal specular reflection, reflectance ks */
+    CDL_MAT_DIELECTRIC,      /* smooth glass of index eta; reflectance ks, transmittance kt */
+    CDL_MAT_CONDUCTOR,       /* GGX microfacet metal: complex index eta3 + i k3, roughness alpha */
+    CDL_MAT_PLASTIC,         /* Lambert kd + GGX dielectric reflection ks (index eta), as pbrt-v3 */
+    CDL_MAT_ROUGH_DIELECTRIC /* GGX microfacet glass of index eta; ks, kt */
 } cdl_mat_type;
 
 typedef struct cdl_material {
     cdl_mat_type type;
-    cdl_vec3 kd;  /* diffuse reflectance, multiplied by the texture */
-    int kd_tex;   /* texture index or -1 */
-    cdl_vec3 ks;  /* specular reflectance (Phong, mirror) */
-    float ns;     /* Phong exponent */
-    float eta;    /* index of refraction (dielectric) */
-    cdl_vec3 ke;  /* emitted radiance from the front face; 0 = not a light */
+    cdl_vec3 kd;      /* diffuse reflectance, multiplied by the texture */
+    int kd_tex;       /* texture index or -1 */
+    cdl_vec3 ks;      /* specular reflectance (Phong, mirror, plastic, glass Kr) */
+    cdl_vec3 kt;      /* specular transmittance (glass Kt) */
+    float ns;         /* Phong exponent */
+    float eta;        /* index of refraction (dielectric, plastic coat) */
+    cdl_vec3 eta3, k3; /* conductor: complex index of refraction per channel */
+    float alpha_x, alpha_y; /* GGX roughness (alpha, not pbrt's "roughness") */
     char name[64];
 } cdl_material;
+
+/* A material with every field at its neutral default. */
+static inline cdl_material cdl_material_default(cdl_mat_type type)
+{
+    cdl_material m = {0};
+    m.type = type;
+    m.kd = cdl_v3(0.5f, 0.5f, 0.5f);
+    m.kd_tex = -1;
+    m.ks = cdl_v3(1.0f, 1.0f, 1.0f);
+    m.kt = cdl_v3(1.0f, 1.0f, 1.0f);
+    m.eta = 1.5f;
+    m.eta3 = cdl_v3(0.2f, 0.92f, 1.1f); /* copper-like, pbrt's default metal */
+    m.k3 = cdl_v3(3.91f, 2.45f, 2.14f);
+    m.alpha_x = m.alpha_y = 0.1f;
+    return m;
+}
 
 #endif

@@ -62,15 +62,22 @@ static int texture_id(cdl_scene *s, tex_cache *tc, const char *full, int *id, cd
 
 /* MTL conventions (illum models of the Wavefront spec) to candela's models. */
 static int convert_material(cdl_scene *s, const char *path, const struct aiMaterial *am,
-                            tex_cache *tc, cdl_material *m, cdl_error *err)
+                            tex_cache *tc, cdl_material *m, int32_t *emit, cdl_error *err)
 {
-    memset(m, 0, sizeof *m);
+    *m = cdl_material_default(CDL_MAT_DIFFUSE);
     struct aiString name;
     if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
         snprintf(m->name, sizeof m->name, "%.63s", name.data);
     m->kd = mat_color(am, AI_MATKEY_COLOR_DIFFUSE, cdl_v3(0.5f, 0.5f, 0.5f));
     m->ks = mat_color(am, AI_MATKEY_COLOR_SPECULAR, cdl_v3(0.0f, 0.0f, 0.0f));
-    m->ke = mat_color(am, AI_MATKEY_COLOR_EMISSIVE, cdl_v3(0.0f, 0.0f, 0.0f));
+    cdl_vec3 ke = mat_color(am, AI_MATKEY_COLOR_EMISSIVE, cdl_v3(0.0f, 0.0f, 0.0f));
+    *emit = -1;
+    if (!cdl_is_black(ke)) {
+        /* MTL Ke: radiance from the front (counter-clockwise) face */
+        int rc = cdl_scene_add_emitter(s, ke, 0, emit, err);
+        if (rc)
+            return rc;
+    }
     m->ns = mat_float(am, AI_MATKEY_SHININESS, 0.0f);
     m->eta = mat_float(am, AI_MATKEY_REFRACTI, 1.0f);
     float d = mat_float(am, AI_MATKEY_OPACITY, 1.0f);
@@ -93,6 +100,7 @@ static int convert_material(cdl_scene *s, const char *path, const struct aiMater
         m->type = CDL_MAT_MIRROR;
     } else if (illum == 7 || (d < 1.0f && m->eta != 1.0f)) {
         m->type = CDL_MAT_DIELECTRIC;
+        m->ks = m->kt = cdl_v3(1.0f, 1.0f, 1.0f); /* MTL's Ks/Tf are not glass colours */
         if (!(m->eta > 0.0f))
             m->eta = 1.5f;
     } else if (cdl_max3(m->ks) > 0.0f) {
@@ -127,10 +135,13 @@ int cdl_load_obj(cdl_scene *s, const char *path, cdl_error *err)
     tex_cache tc = {NULL, NULL, 0};
     uint32_t mat_base = s->nmats;
     float *buf = NULL;
+    int32_t *emit = calloc(as->mNumMaterials + 1, sizeof(int32_t));
+    if (!emit)
+        rc = cdl_error_set(err, CDL_ERR_SYSTEM, path, 0, "out of memory");
     for (unsigned i = 0; i < as->mNumMaterials && !rc; i++) {
         cdl_material m;
         uint32_t id;
-        rc = convert_material(s, path, as->mMaterials[i], &tc, &m, err);
+        rc = convert_material(s, path, as->mMaterials[i], &tc, &m, &emit[i], err);
         if (!rc)
             rc = cdl_scene_add_material(s, &m, &id, err);
     }
@@ -179,10 +190,11 @@ int cdl_load_obj(cdl_scene *s, const char *path, cdl_error *err)
             }
             rc = cdl_scene_add_triangle(s, first + face->mIndices[0], first + face->mIndices[1],
                                         first + face->mIndices[2], mat_base + am->mMaterialIndex,
-                                        flags, err);
+                                        emit[am->mMaterialIndex], flags, err);
         }
     }
     free(buf);
+    free(emit);
     for (int i = 0; i < tc.n; i++)
         free(tc.paths[i]);
     free(tc.paths);

@@ -52,7 +52,14 @@ void cdl_scene_free(cdl_scene *s)
     free(s->uv);
     free(s->idx);
     free(s->tri_mat);
+    free(s->tri_emit);
     free(s->tri_flags);
+    free(s->sph);
+    free(s->sph_mat);
+    free(s->sph_emit);
+    free(s->sph_inward);
+    free(s->sph_light);
+    free(s->emitters);
     free(s->face_n);
     free(s->tri_light);
     free(s->mats);
@@ -70,12 +77,14 @@ int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float
     if (n > UINT32_MAX / 4 - s->nverts)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "too many vertices");
     uint32_t need = s->nverts + n + 1; /* +1: Embree reads 16 bytes per vertex */
-    uint32_t cp = s->cap_verts, cn = s->cap_verts, cu = s->cap_verts;
-    if (grow((void **)&s->pos, &cp, need, 3 * sizeof(float)) ||
-        grow((void **)&s->nrm, &cn, need, 3 * sizeof(float)) ||
-        grow((void **)&s->uv, &cu, need, 2 * sizeof(float)))
-        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for %u vertices", need);
-    s->cap_verts = cp < cn ? (cp < cu ? cp : cu) : (cn < cu ? cn : cu);
+    if (need > s->cap_verts) {
+        uint32_t cp = s->cap_verts, cn = cp, cu = cp;
+        if (grow((void **)&s->pos, &cp, need, 3 * sizeof(float)) ||
+            grow((void **)&s->nrm, &cn, need, 3 * sizeof(float)) ||
+            grow((void **)&s->uv, &cu, need, 2 * sizeof(float)))
+            return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for %u vertices", need);
+        s->cap_verts = cp;
+    }
     for (uint32_t i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++) {
             float x = p[3 * i + k];
@@ -100,9 +109,10 @@ int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float
 }
 
 int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
-                           uint32_t mat, uint8_t flags, cdl_error *err)
+                           uint32_t mat, int32_t emit, uint8_t flags, cdl_error *err)
 {
-    if (a >= s->nverts || b >= s->nverts || c >= s->nverts || mat >= s->nmats)
+    if (a >= s->nverts || b >= s->nverts || c >= s->nverts || mat >= s->nmats ||
+        emit >= (int32_t)s->nemitters || emit < -1)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "triangle index out of range");
     /* Zero-area triangles carry no light and break normals: skip them. */
     const float *pa = s->pos + 3 * (size_t)a, *pb = s->pos + 3 * (size_t)b, *pc = s->pos + 3 * (size_t)c;
@@ -112,17 +122,21 @@ int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
     float len = cdl_length(n);
     if (!(len > 0.0f) || !isfinite(len))
         return 0;
-    uint32_t ci = s->cap_tris, cm = s->cap_tris, cf = s->cap_tris;
-    if (grow((void **)&s->idx, &ci, s->ntris + 1, 3 * sizeof(uint32_t)) ||
-        grow((void **)&s->tri_mat, &cm, s->ntris + 1, sizeof(uint32_t)) ||
-        grow((void **)&s->tri_flags, &cf, s->ntris + 1, sizeof(uint8_t)))
-        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for triangles");
-    s->cap_tris = ci < cm ? (ci < cf ? ci : cf) : (cm < cf ? cm : cf);
+    if (s->ntris == s->cap_tris) {
+        uint32_t ci = s->cap_tris, cm = ci, ce = ci, cf = ci;
+        if (grow((void **)&s->idx, &ci, s->ntris + 1, 3 * sizeof(uint32_t)) ||
+            grow((void **)&s->tri_mat, &cm, s->ntris + 1, sizeof(uint32_t)) ||
+            grow((void **)&s->tri_emit, &ce, s->ntris + 1, sizeof(int32_t)) ||
+            grow((void **)&s->tri_flags, &cf, s->ntris + 1, sizeof(uint8_t)))
+            return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for triangles");
+        s->cap_tris = ci; /* all four grew to the same capacity */
+    }
     uint32_t *t = s->idx + 3 * (size_t)s->ntris;
     t[0] = a;
     t[1] = b;
     t[2] = c;
     s->tri_mat[s->ntris] = mat;
+    s->tri_emit[s->ntris] = emit;
     s->tri_flags[s->ntris] = flags;
     s->ntris++;
     return 0;
@@ -148,6 +162,46 @@ int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *er
     return 0;
 }
 
+int cdl_scene_add_emitter(cdl_scene *s, cdl_vec3 L, int twosided, int32_t *id, cdl_error *err)
+{
+    if (!cdl_is_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "emitted radiance must be finite and >= 0");
+    if (grow((void **)&s->emitters, &s->cap_emitters, s->nemitters + 1, sizeof(cdl_emitter)))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    s->emitters[s->nemitters] = (cdl_emitter){L, twosided};
+    *id = (int32_t)s->nemitters++;
+    return 0;
+}
+
+int cdl_scene_add_sphere(cdl_scene *s, cdl_vec3 c, float radius, uint32_t mat, int32_t emit,
+                         int inward, cdl_error *err)
+{
+    if (!cdl_is_finite3(c) || fabsf(c.x) > CDL_MAX_COORD || fabsf(c.y) > CDL_MAX_COORD ||
+        fabsf(c.z) > CDL_MAX_COORD || !(radius > 0.0f) || radius > CDL_MAX_COORD)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sphere centre or radius out of range");
+    if (mat >= s->nmats || emit >= (int32_t)s->nemitters || emit < -1)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sphere material or emitter out of range");
+    if (s->nspheres == s->cap_spheres) {
+        uint32_t a = s->cap_spheres, b = a, c2 = a, d = a;
+        if (grow((void **)&s->sph, &a, s->nspheres + 1, 4 * sizeof(float)) ||
+            grow((void **)&s->sph_mat, &b, s->nspheres + 1, sizeof(uint32_t)) ||
+            grow((void **)&s->sph_emit, &c2, s->nspheres + 1, sizeof(int32_t)) ||
+            grow((void **)&s->sph_inward, &d, s->nspheres + 1, sizeof(uint8_t)))
+            return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for spheres");
+        s->cap_spheres = a;
+    }
+    float *q = s->sph + 4 * (size_t)s->nspheres;
+    q[0] = c.x;
+    q[1] = c.y;
+    q[2] = c.z;
+    q[3] = radius;
+    s->sph_mat[s->nspheres] = mat;
+    s->sph_emit[s->nspheres] = emit;
+    s->sph_inward[s->nspheres] = (uint8_t)(inward != 0);
+    s->nspheres++;
+    return 0;
+}
+
 static int add_light(cdl_scene *s, const cdl_light *l, cdl_error *err)
 {
     if (grow((void **)&s->lights, &s->cap_lights, s->nlights + 1, sizeof *l))
@@ -156,8 +210,21 @@ static int add_light(cdl_scene *s, const cdl_light *l, cdl_error *err)
     return 0;
 }
 
+static int check_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 L, cdl_error *err)
+{
+    if (!cdl_is_finite3(p) || fabsf(p.x) > CDL_MAX_COORD || fabsf(p.y) > CDL_MAX_COORD ||
+        fabsf(p.z) > CDL_MAX_COORD)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "light position or direction out of range");
+    if (!cdl_is_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "light intensity must be finite and >= 0");
+    return 0;
+}
+
 int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err)
 {
+    int rc = check_light(s, p, I, err);
+    if (rc)
+        return rc;
     cdl_light l;
     memset(&l, 0, sizeof l);
     l.type = CDL_LIGHT_POINT;
@@ -166,12 +233,77 @@ int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *e
     return add_light(s, &l, err);
 }
 
+int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I, float cone_deg,
+                             float delta_deg, cdl_error *err)
+{
+    int rc = check_light(s, p, I, err);
+    if (rc || (rc = check_light(s, dir, I, err)))
+        return rc;
+    float len = cdl_length(dir);
+    if (!(len > 0.0f) || !(cone_deg > 0.0f && cone_deg <= 180.0f) || !(delta_deg >= 0.0f && delta_deg <= cone_deg))
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "spot light needs a direction and 0 <= conedelta <= coneangle <= 180");
+    cdl_light l;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_SPOT;
+    l.p = p;
+    l.n = cdl_scale(dir, 1.0f / len);
+    l.L = I;
+    l.cos_total = cosf(cone_deg * CDL_PI / 180.0f);
+    l.cos_falloff = cosf((cone_deg - delta_deg) * CDL_PI / 180.0f);
+    return add_light(s, &l, err);
+}
+
+int cdl_scene_add_distant_light(cdl_scene *s, cdl_vec3 dir, cdl_vec3 L, cdl_error *err)
+{
+    int rc = check_light(s, dir, L, err);
+    if (rc)
+        return rc;
+    float len = cdl_length(dir);
+    if (!(len > 0.0f))
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "distant light needs from != to");
+    cdl_light l;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_DISTANT;
+    l.n = cdl_scale(dir, 1.0f / len);
+    l.L = L;
+    return add_light(s, &l, err);
+}
+
+int cdl_scene_add_infinite_light(cdl_scene *s, cdl_vec3 L, cdl_error *err)
+{
+    int rc = check_light(s, cdl_v3(0, 0, 0), L, err);
+    if (rc)
+        return rc;
+    for (uint32_t i = 0; i < s->nlights; i++)
+        if (s->lights[i].type == CDL_LIGHT_INFINITE)
+            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "only one infinite light is supported");
+    cdl_light l;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_INFINITE;
+    l.L = L;
+    return add_light(s, &l, err);
+}
+
+/* Area lights from emitting shapes; bounds-dependent lights finished. */
 static int build_lights(cdl_scene *s, cdl_error *err)
 {
     s->tri_light = malloc(sizeof(int32_t) * (s->ntris ? s->ntris : 1));
     s->face_n = malloc(sizeof(cdl_vec3) * (s->ntris ? s->ntris : 1));
-    if (!s->tri_light || !s->face_n)
+    s->sph_light = malloc(sizeof(int32_t) * (s->nspheres ? s->nspheres : 1));
+    if (!s->tri_light || !s->face_n || !s->sph_light)
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    cdl_vec3 centre = cdl_scale(cdl_add(s->bmin, s->bmax), 0.5f);
+    float radius = 0.5f * cdl_length(cdl_sub(s->bmax, s->bmin));
+    s->env_light = -1;
+    for (uint32_t i = 0; i < s->nlights; i++) {
+        cdl_light *l = &s->lights[i];
+        if (l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE) {
+            l->p = centre;
+            l->radius = radius > 0.0f ? radius : 1.0f;
+        }
+        if (l->type == CDL_LIGHT_INFINITE)
+            s->env_light = (int32_t)i;
+    }
     for (uint32_t i = 0; i < s->ntris; i++) {
         const uint32_t *t = s->idx + 3 * (size_t)i;
         cdl_vec3 p0 = cdl_v3(s->pos[3 * t[0]], s->pos[3 * t[0] + 1], s->pos[3 * t[0] + 2]);
@@ -182,9 +314,9 @@ static int build_lights(cdl_scene *s, cdl_error *err)
         float len = cdl_length(c);
         s->face_n[i] = cdl_scale(c, 1.0f / len);
         s->tri_light[i] = -1;
-        const cdl_material *m = &s->mats[s->tri_mat[i]];
-        if (cdl_is_black(m->ke))
+        if (s->tri_emit[i] < 0 || cdl_is_black(s->emitters[s->tri_emit[i]].L))
             continue;
+        const cdl_emitter *em = &s->emitters[s->tri_emit[i]];
         cdl_light l;
         memset(&l, 0, sizeof l);
         l.type = CDL_LIGHT_TRIANGLE;
@@ -193,15 +325,33 @@ static int build_lights(cdl_scene *s, cdl_error *err)
         l.e2 = e2;
         l.n = s->face_n[i];
         l.area = 0.5f * len;
-        l.L = m->ke;
+        l.L = em->L;
+        l.twosided = em->twosided;
         l.prim = i;
         s->tri_light[i] = (int32_t)s->nlights;
         if (add_light(s, &l, err))
             return err->code;
     }
+    for (uint32_t i = 0; i < s->nspheres; i++) {
+        s->sph_light[i] = -1;
+        if (s->sph_emit[i] < 0 || cdl_is_black(s->emitters[s->sph_emit[i]].L))
+            continue;
+        cdl_light l;
+        memset(&l, 0, sizeof l);
+        l.type = CDL_LIGHT_SPHERE;
+        l.p = cdl_v3(s->sph[4 * i], s->sph[4 * i + 1], s->sph[4 * i + 2]);
+        l.radius = s->sph[4 * i + 3];
+        l.area = 4.0f * CDL_PI * l.radius * l.radius;
+        l.L = s->emitters[s->sph_emit[i]].L;
+        l.inward = s->sph_inward[i];
+        l.prim = i;
+        s->sph_light[i] = (int32_t)s->nlights;
+        if (add_light(s, &l, err))
+            return err->code;
+    }
     if (s->nlights == 0)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
-                             "scene has no light (no material with Ke > 0 and no --point-light)");
+                             "scene has no light (no emitting surface and no --point-light)");
     float *w = malloc(sizeof(float) * s->nlights);
     if (!w)
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
@@ -218,33 +368,54 @@ static int build_lights(cdl_scene *s, cdl_error *err)
 
 int cdl_scene_commit(cdl_scene *s, cdl_error *err)
 {
-    if (s->ntris == 0)
+    if (s->ntris == 0 && s->nspheres == 0)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "scene has no (non-degenerate) triangles");
-    int rc = build_lights(s, err);
-    if (rc)
-        return rc;
     cdl_vec3 lo = cdl_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = cdl_scale(lo, -1.0f);
     for (uint32_t i = 0; i < 3 * s->ntris; i++) {
         const float *p = s->pos + 3 * (size_t)s->idx[i];
         lo = cdl_v3(fminf(lo.x, p[0]), fminf(lo.y, p[1]), fminf(lo.z, p[2]));
         hi = cdl_v3(fmaxf(hi.x, p[0]), fmaxf(hi.y, p[1]), fmaxf(hi.z, p[2]));
     }
+    for (uint32_t i = 0; i < s->nspheres; i++) {
+        const float *q = s->sph + 4 * (size_t)i;
+        lo = cdl_v3(fminf(lo.x, q[0] - q[3]), fminf(lo.y, q[1] - q[3]), fminf(lo.z, q[2] - q[3]));
+        hi = cdl_v3(fmaxf(hi.x, q[0] + q[3]), fmaxf(hi.y, q[1] + q[3]), fmaxf(hi.z, q[2] + q[3]));
+    }
     s->bmin = lo;
     s->bmax = hi;
     s->eps = 1e-6f * cdl_max3(cdl_sub(hi, lo));
+    int rc = build_lights(s, err);
+    if (rc)
+        return rc;
 
     s->rtc = rtcNewScene(s->device);
-    RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    if (!s->rtc || !g)
+    if (!s->rtc)
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree could not create the scene");
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->pos, 0,
-                               3 * sizeof(float), s->nverts);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->idx, 0,
-                               3 * sizeof(uint32_t), s->ntris);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(s->rtc, g);
-    rtcReleaseGeometry(g);
+    /* Geometry ids are fixed (CDL_GEOM_*) even when a kind is absent. */
+    RTCGeometry g;
+    if (s->ntris) {
+        g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (!g)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree could not create a mesh");
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->pos, 0,
+                                   3 * sizeof(float), s->nverts);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->idx, 0,
+                                   3 * sizeof(uint32_t), s->ntris);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s->rtc, g, CDL_GEOM_TRIANGLES);
+        rtcReleaseGeometry(g);
+    }
+    if (s->nspheres) {
+        g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        if (!g)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree could not create spheres");
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, s->sph, 0,
+                                   4 * sizeof(float), s->nspheres);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s->rtc, g, CDL_GEOM_SPHERES);
+        rtcReleaseGeometry(g);
+    }
     rtcCommitScene(s->rtc);
     enum RTCError e = rtcGetDeviceError(s->device);
     if (e != RTC_ERROR_NONE)
@@ -282,8 +453,31 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
     }
 }
 
+static void sphere_surface(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+{
+    const float *q = s->sph + 4 * (size_t)h->prim;
+    cdl_vec3 c = cdl_v3(q[0], q[1], q[2]);
+    cdl_vec3 n = cdl_normalize(h->ng);
+    if (s->sph_inward[h->prim])
+        n = cdl_neg(n);
+    /* the point on the analytic surface, not o + t d with its rounding */
+    cdl_vec3 out = s->sph_inward[h->prim] ? cdl_neg(n) : n;
+    sf->p = cdl_madd(c, out, q[3]);
+    sf->ng = sf->ns = n;
+    sf->u = 0.5f + atan2f(out.z, out.x) * (0.5f * CDL_INV_PI);
+    sf->v = acosf(cdl_maxf(-1.0f, cdl_minf(1.0f, out.y))) * CDL_INV_PI;
+    sf->prim = h->prim;
+    sf->geom = CDL_GEOM_SPHERES;
+    sf->mat = s->sph_mat[h->prim];
+    sf->light = s->sph_light[h->prim];
+}
+
 void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
+    if (h->geom == CDL_GEOM_SPHERES) {
+        sphere_surface(s, h, sf);
+        return;
+    }
     const uint32_t *t = s->idx + 3 * (size_t)h->prim;
     float b0 = 1.0f - h->b1 - h->b2;
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
@@ -313,6 +507,7 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
         sf->v = b0 * u0[1] + h->b1 * u1[1] + h->b2 * u2[1];
     }
     sf->prim = h->prim;
+    sf->geom = CDL_GEOM_TRIANGLES;
     sf->mat = s->tri_mat[h->prim];
     sf->light = s->tri_light[h->prim];
 }

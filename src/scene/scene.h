@@ -19,6 +19,12 @@
  * larger than any sensible scene detail. */
 #define CDL_MAX_COORD 1e20f
 
+/* Emission attached to shapes (an MTL Ke, a pbrt AreaLightSource). */
+typedef struct cdl_emitter {
+    cdl_vec3 L;   /* radiance */
+    int twosided; /* triangles: both faces emit; otherwise the CCW front face */
+} cdl_emitter;
+
 typedef struct cdl_scene {
     RTCDevice device;
     RTCScene rtc;
@@ -29,9 +35,21 @@ typedef struct cdl_scene {
     float *uv;         /* 2 per vertex */
     uint32_t *idx;     /* 3 per triangle */
     uint32_t *tri_mat; /* material per triangle */
+    int32_t *tri_emit; /* emitter per triangle or -1 */
     uint8_t *tri_flags;
     cdl_vec3 *face_n;  /* unit CCW normal per triangle (after commit) */
     int32_t *tri_light; /* light index per triangle or -1 (after commit) */
+
+    /* analytic spheres, geometry 1 of the Embree scene */
+    uint32_t nspheres, cap_spheres;
+    float *sph;          /* x, y, z, radius per sphere (Embree's layout) */
+    uint32_t *sph_mat;
+    int32_t *sph_emit;
+    uint8_t *sph_inward; /* ReverseOrientation: normals (and emission) point inwards */
+    int32_t *sph_light;  /* after commit */
+
+    cdl_emitter *emitters;
+    uint32_t nemitters, cap_emitters;
 
     cdl_material *mats;
     uint32_t nmats, cap_mats;
@@ -41,6 +59,7 @@ typedef struct cdl_scene {
     uint32_t nlights, cap_lights;
     cdl_alias light_select;
 
+    int32_t env_light;   /* index of the infinite light or -1 (after commit) */
     cdl_vec3 bmin, bmax; /* bounds of the geometry (after commit) */
     float eps;           /* ray offset scale (after commit) */
     char path[1024];     /* file the scene came from, for messages */
@@ -55,26 +74,42 @@ void cdl_scene_free(cdl_scene *s);
  * through *first. */
 int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float *nrm,
                            const float *uv, uint32_t *first, cdl_error *err);
+/* emit: emitter index or -1. Degenerate triangles are dropped silently. */
 int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
-                           uint32_t mat, uint8_t flags, cdl_error *err);
+                           uint32_t mat, int32_t emit, uint8_t flags, cdl_error *err);
+int cdl_scene_add_emitter(cdl_scene *s, cdl_vec3 L, int twosided, int32_t *id, cdl_error *err);
+/* An analytic sphere; inward flips its normal (pbrt's ReverseOrientation). */
+int cdl_scene_add_sphere(cdl_scene *s, cdl_vec3 c, float radius, uint32_t mat, int32_t emit,
+                         int inward, cdl_error *err);
 int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err);
 int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *err);
 /* I is the intensity in W/sr. */
 int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err);
+/* Spot at p pointing along dir; cone angles in degrees (pbrt's coneangle, conedelta). */
+int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I, float cone_deg,
+                             float delta_deg, cdl_error *err);
+/* Radiance L arriving from direction -dir (dir: the way the light travels). */
+int cdl_scene_add_distant_light(cdl_scene *s, cdl_vec3 dir, cdl_vec3 L, cdl_error *err);
+/* Constant radiance L from every direction (at most one). */
+int cdl_scene_add_infinite_light(cdl_scene *s, cdl_vec3 L, cdl_error *err);
 int cdl_scene_commit(cdl_scene *s, cdl_error *err);
 
 /* ---- ray queries ---- */
 
+enum { CDL_GEOM_TRIANGLES = 0, CDL_GEOM_SPHERES = 1 };
+
 typedef struct cdl_hit {
     float t, b1, b2; /* distance and barycentrics of vertices 1 and 2 */
-    uint32_t prim;
+    uint32_t prim;   /* triangle or sphere index */
+    uint32_t geom;   /* CDL_GEOM_* */
+    cdl_vec3 ng;     /* Embree's unnormalized geometric normal */
 } cdl_hit;
 
 typedef struct cdl_surface {
     cdl_vec3 p, ng, ns; /* ng: unit CCW normal */
     float u, v;
-    uint32_t prim, mat;
-    int32_t light;      /* index of the area light on this triangle, or -1 */
+    uint32_t prim, geom, mat;
+    int32_t light;      /* index of the area light on this shape, or -1 */
 } cdl_surface;
 
 static inline struct RTCIntersectContext cdl_context(void)
@@ -110,6 +145,8 @@ static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, floa
     h->b1 = rh.hit.u;
     h->b2 = rh.hit.v;
     h->prim = rh.hit.primID;
+    h->geom = rh.hit.geomID;
+    h->ng = cdl_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     return 1;
 }
 
