@@ -49,7 +49,7 @@ int main(int argc, char **argv)
     cdl_error err;
     int rc = cdl_scene_init(&s, argv[1], &err);
     if (!rc)
-        rc = cdl_scene_load(&s, argv[1], &err);
+        rc = cdl_scene_load(&s, argv[1], NULL, &err);
     if (!rc && has_pl)
         rc = cdl_scene_add_point_light(&s, cdl_v3(pl[0], pl[1], pl[2]), cdl_v3(pl[3], pl[4], pl[5]), &err);
     if (!rc)

@@ -185,6 +185,24 @@ static void test_gamma(void)
           worst);
 }
 
+/* cdl_light_pdf_li of the light point p seen from ref, whichever of its
+ * two signatures scene/light.h declares: (l, ref, p), or (l, ref, wi,
+ * dist) with wi and dist computed as cdl_light_sample_li does. Only the
+ * branch matching the declaration is evaluated. */
+typedef float (*pdf_li_by_point)(const cdl_light *, cdl_vec3, cdl_vec3);
+typedef float (*pdf_li_by_dir)(const cdl_light *, cdl_vec3, cdl_vec3, float);
+
+static float pdf_li_at(const cdl_light *l, cdl_vec3 ref, cdl_vec3 p)
+{
+    cdl_vec3 d = cdl_sub(p, ref);
+    float dist = sqrtf(cdl_dot(d, d));
+    cdl_vec3 wi = cdl_scale(d, 1.0f / dist);
+    void (*fn)(void) = (void (*)(void))cdl_light_pdf_li;
+    return _Generic(&cdl_light_pdf_li,
+                    pdf_li_by_point: ((pdf_li_by_point)fn)(l, ref, p),
+                    default: ((pdf_li_by_dir)fn)(l, ref, wi, dist));
+}
+
 /* ---- triangle light ------------------------------------------------------ */
 
 #define NTRI 200000
@@ -322,7 +340,7 @@ static void test_triangle(void)
         double cos_l = -ddot(w, n);
         double pdf_geo = dist * dist / (cos_l * area);
         max_pdf_geo = fmax(max_pdf_geo, rel_err(ls.pdf, pdf_geo));
-        max_pdf_li = fmax(max_pdf_li, rel_err(ls.pdf, cdl_light_pdf_li(&l, ref, ls.p)));
+        max_pdf_li = fmax(max_pdf_li, rel_err(ls.pdf, pdf_li_at(&l, ref, ls.p)));
         if (ls.delta || ls.Li.x != 1.0f || ls.Li.y != 2.0f || ls.Li.z != 3.0f || !(ls.pdf > 0.0f))
             bad_misc++;
         /* Area density of the same point: pdf_li cos_l / dist^2 = 1 / area. */
@@ -385,12 +403,12 @@ static void test_triangle(void)
             double t = intersect(front, d, p0, e1, e2);
             if (t > 0.0) {
                 hits_f++;
-                sum_f += cdl_light_pdf_li(&l, ref, to_f(dadd(front, dscale(d, t))));
+                sum_f += pdf_li_at(&l, ref, to_f(dadd(front, dscale(d, t))));
             }
             t = intersect(behind, d, p0, e1, e2);
             if (t > 0.0) {
                 hits_b++;
-                double pb = cdl_light_pdf_li(&l, to_f(behind), to_f(dadd(behind, dscale(d, t))));
+                double pb = pdf_li_at(&l, to_f(behind), to_f(dadd(behind, dscale(d, t))));
                 sum_b += pb;
                 nonzero_b += pb != 0.0;
             }
@@ -509,11 +527,11 @@ static void test_point(void)
                         fmax(rel_err(ls.Li.y, 3.0 / d2), rel_err(ls.Li.z, 4.0 / d2)));
         double ed = fmax(dlen(dsub(from_f(ls.wi), dscale(d, 1.0 / dist))), rel_err(ls.dist, dist));
         check(ok && e <= 1e-5 && ed <= 1e-5 && ls.delta == 1 && ls.pdf == 1.0f &&
-                  cdl_light_pdf_li(&l, to_f(refs[i]), l.p) == 0.0f,
+                  pdf_li_at(&l, to_f(refs[i]), l.p) == 0.0f,
               "point light at d=%.3f: Li (%.5f, %.5f, %.5f) vs I/d^2 (%.5f, %.5f, %.5f) rel err %.1e, "
               "wi/dist err %.1e, delta %d, pdf %g, pdf_li %g",
               dist, ls.Li.x, ls.Li.y, ls.Li.z, 2.0 / d2, 3.0 / d2, 4.0 / d2, e, ed, ls.delta, ls.pdf,
-              cdl_light_pdf_li(&l, to_f(refs[i]), l.p));
+              pdf_li_at(&l, to_f(refs[i]), l.p));
     }
     static double hist[10 * 20], expd[10 * 20];
     memset(hist, 0, sizeof hist);
@@ -561,6 +579,22 @@ static void test_point(void)
 
 /* ---- alias table ---------------------------------------------------------- */
 
+/* cdl_alias_sample takes one uniform (slot and acceptance both from u * n);
+ * a two-uniform form (u_slot, u_accept) is the fix proposed for its
+ * precision. The tests run with either: only the branch matching the
+ * declaration in core/alias.h is evaluated. */
+typedef uint32_t (*alias_1u)(const cdl_alias *, float, float *);
+typedef uint32_t (*alias_2u)(const cdl_alias *, float, float, float *);
+#define ALIAS_TWO_UNIFORMS _Generic(&cdl_alias_sample, alias_1u: 0, default: 1)
+
+static uint32_t alias_draw(const cdl_alias *a, float u_slot, float u_accept, float *pmf)
+{
+    void (*fn)(void) = (void (*)(void))cdl_alias_sample;
+    return _Generic(&cdl_alias_sample,
+                    alias_1u: ((alias_1u)fn)(a, u_slot, pmf),
+                    default: ((alias_2u)fn)(a, u_slot, u_accept, pmf));
+}
+
 /* The distribution the table defines: slot i taken with 1/n, then i with
  * prob[i], alias[i] otherwise. */
 static double table_error(const cdl_alias *a)
@@ -577,16 +611,51 @@ static double table_error(const cdl_alias *a)
 }
 
 /* The distribution cdl_alias_sample really draws from with the renderer's
- * uniforms, cdl_rng_float: every multiple of 2^-24 in [0, 1) once. Reports
- * the largest relative deviation from the pmf over the entries of pmf >=
- * min_pmf, the number of entries with pmf > 0 never drawn, and the total
- * variation distance. */
+ * uniforms (cdl_rng_float, cdl_sampler_1d: multiples of 2^-24 in [0, 1)),
+ * computed exactly: with one uniform, by drawing with each of the 2^24
+ * values once; with two, for each u_slot the result switches once from
+ * the slot's entry to its alias as u_accept grows, found by bisection.
+ * Reports the largest relative deviation from the pmf over the entries of
+ * pmf >= min_pmf, the number of entries with pmf > 0 never drawn, and the
+ * total variation distance. */
 static void exact_distribution(const cdl_alias *a, double min_pmf, double *max_rel, long *never,
                                double *tv, long *zero_drawn)
 {
-    double *cnt = calloc(a->n, sizeof(double));
-    for (uint32_t k = 0; k < (1u << 24); k++)
-        cnt[cdl_alias_sample(a, (float)k * 0x1p-24f, NULL)] += 1.0;
+    const uint32_t M = 1u << 24;
+    const float last = (float)(M - 1) * 0x1p-24f;
+    double *cnt = calloc(a->n, sizeof(double)); /* in units of 2^-24 */
+    if (!ALIAS_TWO_UNIFORMS) {
+        for (uint32_t k = 0; k < M; k++)
+            cnt[alias_draw(a, (float)k * 0x1p-24f, 0.0f, NULL)] += 1.0;
+    } else {
+        uint32_t k = 0;
+        while (k < M) {
+            float u = (float)k * 0x1p-24f;
+            uint32_t lo = alias_draw(a, u, 0.0f, NULL), hi = alias_draw(a, u, last, NULL);
+            uint32_t run = 1; /* u_slot values drawing the same pair */
+            while (k + run < M) {
+                float v = (float)(k + run) * 0x1p-24f;
+                if (alias_draw(a, v, 0.0f, NULL) != lo || alias_draw(a, v, last, NULL) != hi)
+                    break;
+                run++;
+            }
+            uint32_t m = M; /* first u_accept index drawing hi */
+            if (lo != hi) {
+                uint32_t l = 0, r = M - 1;
+                while (l < r) {
+                    uint32_t mid = l + (r - l) / 2;
+                    if (alias_draw(a, u, (float)mid * 0x1p-24f, NULL) == lo)
+                        l = mid + 1;
+                    else
+                        r = mid;
+                }
+                m = l;
+            }
+            cnt[lo] += (double)run * m * 0x1p-24;
+            cnt[hi] += (double)run * (M - m) * 0x1p-24;
+            k += run;
+        }
+    }
     *max_rel = 0.0;
     *never = 0;
     *tv = 0.0;
@@ -626,7 +695,8 @@ static void test_alias(void)
     cdl_rng_seed(&rng, 0xa11a5ULL, 1);
     for (int s = 0; s < N; s++) {
         float pm = -1.0f;
-        uint32_t k = cdl_alias_sample(&a, cdl_rng_float(&rng), &pm);
+        float us = cdl_rng_float(&rng), ua = cdl_rng_float(&rng);
+        uint32_t k = alias_draw(&a, us, ua, &pm);
         if (k >= 5) {
             bad_pmf++;
             continue;
@@ -651,9 +721,9 @@ static void test_alias(void)
     long never, zd;
     exact_distribution(&a, 0.0, &mr, &never, &tv, &zd);
     check(mr <= 1e-5 && zd == 0 && never == 0,
-          "alias sampling over all 2^24 RNG floats {1, 0, 3, 6, 0.5}: max relative deviation from "
-          "the pmf %.2e (<= 1e-5), zero weights drawn %ld, positive weights never drawn %ld",
-          mr, zd, never);
+          "alias sampling over all 2^24 RNG floats {1, 0, 3, 6, 0.5} (%s): max relative deviation "
+          "from the pmf %.2e (<= 1e-5), zero weights drawn %ld, positive weights never drawn %ld",
+          ALIAS_TWO_UNIFORMS ? "two uniforms" : "one uniform", mr, zd, never);
     cdl_alias_free(&a);
     check(a.prob == NULL && a.alias == NULL && a.pmf == NULL && a.n == 0,
           "alias free resets the table");

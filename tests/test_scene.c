@@ -18,7 +18,7 @@ int main(int argc, char **argv)
     cdl_scene s;
     cdl_error err;
     die_on(cdl_scene_init(&s, argv[1], &err), &err);
-    die_on(cdl_scene_load(&s, argv[1], &err), &err);
+    die_on(cdl_scene_load(&s, argv[1], NULL, &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
     CHECK(s.ntris == 36, "Cornell box has %u triangles (36)", s.ntris);
     CHECK(s.nlights == 2, "%u area lights (the two triangles of the light quad)", s.nlights);

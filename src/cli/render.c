@@ -36,6 +36,8 @@ typedef struct render_args {
     int nlights;
     double exposure;
     cdl_sampler_kind sampler;
+    /* given on the command line (else the scene file or the default decides) */
+    int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;
 
 static void render_help(void)
@@ -135,6 +137,7 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
             if (!cdl_integrator_find(v))
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "unknown integrator '%s' (see --help)", v);
             a->integrator = v;
+            a->has_integrator = 1;
         } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
             if (a->nout == MAX_OUT)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "at most %d outputs", MAX_OUT);
@@ -146,13 +149,16 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
             rc = cdl_arg_float(o, v, 1e-3, 1e7, &a->time, err);
         } else if (!strcmp(o, "--res")) {
             rc = cdl_arg_res(o, v, 16384, &a->width, &a->height, err);
+            a->has_res = 1;
         } else if (!strcmp(o, "--lookat")) {
             rc = cdl_arg_floats(o, v, 9, a->lookat, err);
             a->has_lookat = 1;
         } else if (!strcmp(o, "--fov")) {
             rc = cdl_arg_float(o, v, 1e-3, 179.999, &a->fov, err);
+            a->has_fov = 1;
         } else if (!strcmp(o, "--maxdepth")) {
             rc = cdl_arg_int(o, v, 0, 1024, &a->maxdepth, err);
+            a->has_maxdepth = 1;
         } else if (!strcmp(o, "--seed")) {
             rc = cdl_arg_int(o, v, 0, 2147483647L, &l, err);
             a->seed = (unsigned long long)l;
@@ -183,9 +189,22 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_USAGE, "render", 0, "no scene file given (see candela render --help)");
     if (a->spp && a->time > 0.0)
         return cdl_error_set(err, CDL_ERR_USAGE, "--time", 0, "give either --spp or --time, not both");
-    if (!a->spp && a->time <= 0.0)
-        a->spp = 64;
     return 0;
+}
+
+/* Scene-file settings fill in what the command line left open. */
+static void apply_settings(render_args *a, const cdl_scene_settings *set)
+{
+    if (!a->has_integrator && set->integrator[0] && cdl_integrator_find(set->integrator))
+        a->integrator = set->integrator;
+    if (!a->has_res && set->width > 0 && set->height > 0) {
+        a->width = set->width;
+        a->height = set->height;
+    }
+    if (!a->has_maxdepth && set->maxdepth >= 0)
+        a->maxdepth = set->maxdepth > 1024 ? 1024 : set->maxdepth;
+    if (!a->spp && a->time <= 0.0)
+        a->spp = set->spp > 0 ? set->spp : 64;
 }
 
 static void on_sigint(int sig)
@@ -206,8 +225,15 @@ static int frame_scene(const cdl_scene *s, double fov, int w, int h, cdl_camera 
     return cdl_camera_init(cam, eye, c, cdl_v3(0.0f, 1.0f, 0.0f), (float)fov, w, h, err);
 }
 
-static void default_output(const char *scene, char *buf, size_t n)
+static void default_output(const char *scene, const cdl_scene_settings *set, char *buf, size_t n)
 {
+    if (set->filename[0] && (cdl_image_has_ext(set->filename, ".exr") ||
+                             cdl_image_has_ext(set->filename, ".png") ||
+                             cdl_image_has_ext(set->filename, ".pfm"))) {
+        const char *b = strrchr(set->filename, '/');
+        snprintf(buf, n, "%s", b ? b + 1 : set->filename);
+        return;
+    }
     const char *base = strrchr(scene, '/');
     base = base ? base + 1 : scene;
     const char *dot = strrchr(base, '.');
@@ -224,28 +250,32 @@ int cdl_cmd_render(int argc, char **argv)
         return 0;
     if (rc)
         return cdl_report(&err);
-    char defout[1024];
-    if (a.nout == 0) {
-        default_output(a.scene, defout, sizeof defout);
-        a.out[a.nout++] = defout;
-    }
     if (a.threads > 0)
         omp_set_num_threads((int)a.threads);
 
     double t_load = cdl_time_now();
     cdl_scene scene;
+    cdl_scene_settings set;
     cdl_options opt;
+    char defout[1024];
     cdl_integrator integ = {0};
     cdl_film film = {0};
     cdl_image img = {0};
     rc = cdl_scene_init(&scene, a.scene, &err);
     if (!rc)
-        rc = cdl_scene_load(&scene, a.scene, &err);
+        rc = cdl_scene_load(&scene, a.scene, &set, &err);
     for (int i = 0; !rc && i < a.nlights; i++)
         rc = cdl_scene_add_point_light(&scene, cdl_v3(a.lights[i][0], a.lights[i][1], a.lights[i][2]),
                                        cdl_v3(a.lights[i][3], a.lights[i][4], a.lights[i][5]), &err);
     if (!rc)
         rc = cdl_scene_commit(&scene, &err);
+    if (!rc) {
+        apply_settings(&a, &set);
+        if (a.nout == 0) {
+            default_output(a.scene, &set, defout, sizeof defout);
+            a.out[a.nout++] = defout;
+        }
+    }
     cdl_options_default(&opt);
     opt.maxdepth = (int)a.maxdepth;
     opt.seed = a.seed;
@@ -255,6 +285,9 @@ int cdl_cmd_render(int argc, char **argv)
                              cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),
                              cdl_v3(a.lookat[6], a.lookat[7], a.lookat[8]), (float)a.fov, a.width,
                              a.height, &err);
+    else if (!rc && set.has_camera)
+        rc = cdl_camera_init_frame(&opt.camera, set.eye, set.right, set.up, set.fwd,
+                                   a.has_fov ? (float)a.fov : set.fov, a.width, a.height, &err);
     else if (!rc)
         rc = frame_scene(&scene, a.fov, a.width, a.height, &opt.camera, &err);
     if (!rc)

@@ -28,3 +28,26 @@ int cdl_camera_init(cdl_camera *c, cdl_vec3 eye, cdl_vec3 target, cdl_vec3 up,
     c->aspect = (float)width / (float)height;
     return 0;
 }
+
+int cdl_camera_init_frame(cdl_camera *c, cdl_vec3 eye, cdl_vec3 right, cdl_vec3 up, cdl_vec3 fwd,
+                          float fov_deg, int width, int height, cdl_error *err)
+{
+    if (!(fov_deg > 0.0f && fov_deg < 180.0f))
+        return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "field of view must be in (0, 180) degrees, got %g",
+                             (double)fov_deg);
+    if (width <= 0 || height <= 0)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--res", 0, "resolution must be positive");
+    cdl_vec3 det = cdl_cross(right, up);
+    if (!cdl_is_finite3(eye) || !cdl_is_finite3(fwd) || !(fabsf(cdl_dot(det, fwd)) > 1e-12f))
+        return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "camera transform is singular or not finite");
+    c->eye = eye;
+    c->fwd = fwd;
+    c->right = right;
+    c->up = up;
+    c->width = width;
+    c->height = height;
+    c->aspect = (float)width / (float)height;
+    float t = tanf(0.5f * fov_deg * CDL_PI / 180.0f);
+    c->tan_half = width >= height ? t : t / c->aspect;
+    return 0;
+}

@@ -7,7 +7,7 @@
 #include "core/vec.h"
 
 typedef struct cdl_camera {
-    cdl_vec3 eye, fwd, right, up; /* orthonormal */
+    cdl_vec3 eye, fwd, right, up; /* world images of camera z, x, y (orthonormal for --lookat) */
     float tan_half;               /* tan(vertical fov / 2) */
     float aspect;                 /* width / height */
     int width, height;
@@ -16,6 +16,13 @@ typedef struct cdl_camera {
 /* fov_deg is the vertical field of view; fails on degenerate frames. */
 int cdl_camera_init(cdl_camera *c, cdl_vec3 eye, cdl_vec3 target, cdl_vec3 up,
                     float fov_deg, int width, int height, cdl_error *err);
+
+/* A camera-to-world frame as pbrt gives it: eye and the world images of
+ * the camera's +x (image right), +y (image up) and +z (view) axes, which
+ * may form a left- or right-handed, even non-orthonormal, frame; the field
+ * of view applies to the shorter image axis, as in pbrt. */
+int cdl_camera_init_frame(cdl_camera *c, cdl_vec3 eye, cdl_vec3 right, cdl_vec3 up, cdl_vec3 fwd,
+                          float fov_deg, int width, int height, cdl_error *err);
 
 /* Unit direction through raster position (x, y) in pixels. */
 static inline cdl_vec3 cdl_camera_ray(const cdl_camera *c, float x, float y)

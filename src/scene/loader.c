@@ -1,18 +1,35 @@
 #include "scene/loader.h"
 
 #include <stdlib.h>
-#include <strings.h>
 #include <string.h>
+#include <strings.h>
 
 #include "scene/obj_check.h"
 #include "scene/obj_loader.h"
+#include "scene/pbrt_loader.h"
 
-int cdl_scene_load(cdl_scene *s, const char *path, cdl_error *err)
+void cdl_scene_settings_init(cdl_scene_settings *set)
 {
-    const char *dot = strrchr(path, '.');
-    const char *slash = strrchr(path, '/');
-    if (dot && (!slash || dot > slash) && !strcasecmp(dot, ".obj"))
+    memset(set, 0, sizeof *set);
+    set->maxdepth = -1;
+}
+
+static int has_ext(const char *path, const char *ext)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    return dot && (!slash || dot > slash) && !strcasecmp(dot, ext);
+}
+
+int cdl_scene_load(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_error *err)
+{
+    cdl_scene_settings dummy;
+    if (!set)
+        set = &dummy;
+    cdl_scene_settings_init(set);
+    if (has_ext(path, ".obj"))
         return cdl_load_obj(s, path, err);
+    if (has_ext(path, ".pbrt"))
+        return cdl_load_pbrt(s, path, set, err);
     /* A missing file is a clearer message than an unknown format. */
     char *data;
     size_t size;
@@ -20,5 +37,5 @@ int cdl_scene_load(cdl_scene *s, const char *path, cdl_error *err)
     if (rc)
         return rc;
     free(data);
-    return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "unknown scene format (expected .obj)");
+    return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "unknown scene format (expected .obj or .pbrt)");
 }
