@@ -17,13 +17,15 @@ typedef struct cdl_alias {
 int cdl_alias_build(cdl_alias *a, const float *w, uint32_t n);
 void cdl_alias_free(cdl_alias *a);
 
-static inline uint32_t cdl_alias_sample(const cdl_alias *a, float u, float *pmf)
+/* u_slot picks one of the n slots, u_accept the slot's entry or its
+ * alias. One float cannot serve both: u * n leaves only 24 - log2(n) bits
+ * for the acceptance test, which skews the pmf when n is large. */
+static inline uint32_t cdl_alias_sample(const cdl_alias *a, float u_slot, float u_accept, float *pmf)
 {
-    float x = u * (float)a->n;
-    uint32_t i = (uint32_t)x;
+    uint32_t i = (uint32_t)((double)u_slot * a->n);
     if (i >= a->n)
         i = a->n - 1;
-    uint32_t k = (x - (float)i) < a->prob[i] ? i : a->alias[i];
+    uint32_t k = u_accept < a->prob[i] ? i : a->alias[i];
     if (pmf)
         *pmf = a->pmf[k];
     return k;

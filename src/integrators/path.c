@@ -32,8 +32,9 @@ static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *o
 static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b,
                            cdl_vec3 wo, cdl_sampler *smp, uint64_t *rays)
 {
-    float pmf, u1, u2;
-    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, cdl_sampler_1d(smp), &pmf)];
+    float pmf, us, ua, u1, u2;
+    cdl_sampler_2d(smp, &us, &ua);
+    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, us, ua, &pmf)];
     cdl_light_sample ls;
     cdl_sampler_2d(smp, &u1, &u2);
     if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))

@@ -18,7 +18,9 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->frame = cdl_frame_from(ns);
     b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PHONG) {
-        float d = cdl_luminance(kd), s = cdl_luminance(b->ks);
+        /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
+         * proportion keeps every sample's weight within Kd + Ks (n+2)/(n+1) */
+        float d = cdl_luminance(kd), s = cdl_luminance(b->ks) * (b->ns + 2.0f) / (b->ns + 1.0f);
         b->p_spec = d + s > 0.0f ? s / (d + s) : 0.0f;
     }
 }
