@@ -264,7 +264,7 @@ static void integrand(integ *g, double c, double phi, double out[2])
     out[0] = cdl_bsdf_pdf(g->b, g->wo, wi);
     out[1] = 0.0;
     if (g->albedo) {
-        cdl_vec3 f = cdl_bsdf_eval(g->b, g->wo, wi);
+        cdl_vec3 f = cdl_bsdf_eval(g->b, g->wo, wi, 0);
         out[1] = f.x * fabs(cdl_dot(wi, g->b->frame.n));
     }
 }
@@ -359,6 +359,9 @@ static cdl_material make_material(cdl_mat_type type, float kd, float ks, float n
     m.type = type;
     m.kd = cdl_v3(kd, kd, kd);
     m.ks = cdl_v3(ks, ks, ks);
+    m.kt = cdl_v3(1.0f, 1.0f, 1.0f);
+    if (type == CDL_MAT_DIELECTRIC)
+        m.ks = m.kt; /* clear glass: Fresnel alone decides */
     m.ns = ns;
     m.eta = eta;
     m.kd_tex = -1;
@@ -428,7 +431,7 @@ static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64
             bad_side++;
         double pdf2 = cdl_bsdf_pdf(&b, wo, sc.wi);
         max_pdf_err = fmax(max_pdf_err, rel_err(pdf2, sc.pdf));
-        cdl_vec3 f = cdl_bsdf_eval(&b, wo, sc.wi);
+        cdl_vec3 f = cdl_bsdf_eval(&b, wo, sc.wi, 0);
         double cs = fabs(cdl_dot(sc.wi, b.frame.n));
         double we[3] = {f.x * cs / sc.pdf, f.y * cs / sc.pdf, f.z * cs / sc.pdf};
         double fs[3] = {f.x, f.y, f.z};
@@ -605,7 +608,7 @@ static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64
             rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
             bb = cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
         }
-        cdl_vec3 f1 = cdl_bsdf_eval(&b, bb, a), f2 = cdl_bsdf_eval(&b, a, bb);
+        cdl_vec3 f1 = cdl_bsdf_eval(&b, bb, a, 0), f2 = cdl_bsdf_eval(&b, a, bb, 0);
         if (!cdl_is_black(f1))
             nonzero++;
         max_rec = fmax(max_rec, rel_err(f1.x, f2.x));
@@ -663,7 +666,7 @@ static void test_mirror(double wo_deg, int tilted, double tilt_az_deg)
         check(wrong_misc == 0, "%s: weight = ks, pdf = 1, delta = 1: %ld violations", tag,
               wrong_misc);
     }
-    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(want));
+    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(want), 0);
     float p = cdl_bsdf_pdf(&b, wo, to_f(want));
     check(cdl_is_black(f) && p == 0.0f, "%s: eval (%g) and pdf (%g) of a delta BSDF are 0", tag,
           f.x, p);
@@ -818,7 +821,7 @@ static void test_dielectric(double theta_deg, int entering, int tilted)
           "%s: pdf of reflection %.6f (F = %.6f within 1e-4), of refraction %.6f (sum 1 within "
           "1e-6), %ld samples with another pdf",
           tag, pr, flib, pt, bad_pdf);
-    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(refl));
+    cdl_vec3 f = cdl_bsdf_eval(&b, wo, to_f(refl), 0);
     float p = cdl_bsdf_pdf(&b, wo, to_f(refl));
     check(cdl_is_black(f) && p == 0.0f, "%s: eval (%g) and pdf (%g) of a delta BSDF are 0", tag,
           f.x, p);

@@ -39,7 +39,7 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
     cdl_sampler_2d(smp, &u1, &u2);
     if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi);
+    cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
     if (cdl_is_black(f))
         return f;
     cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);

@@ -1,6 +1,7 @@
 #include "scene/bsdf.h"
 
 #include "core/sampling.h"
+#include "scene/microfacet.h"
 
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
                    cdl_vec3 ns, cdl_vec3 ng)
@@ -8,8 +9,14 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->type = m->type;
     b->kd = kd;
     b->ks = m->ks;
+    b->kt = m->kt;
     b->ns = m->ns;
     b->eta = m->eta;
+    b->eta3 = m->eta3;
+    b->k3 = m->k3;
+    /* below ~1e-4 the GGX lobe underflows in float */
+    b->ax = cdl_maxf(m->alpha_x, 1e-4f);
+    b->ay = cdl_maxf(m->alpha_y, 1e-4f);
     b->ng = ng;
     /* Shading normal on the geometric normal's side: interpolated normals
      * of a mesh with flipped winding must not turn the frame inside out. */
@@ -21,6 +28,9 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
         /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
          * proportion keeps every sample's weight within Kd + Ks (n+2)/(n+1) */
         float d = cdl_luminance(kd), s = cdl_luminance(b->ks) * (b->ns + 2.0f) / (b->ns + 1.0f);
+        b->p_spec = d + s > 0.0f ? s / (d + s) : 0.0f;
+    } else if (b->type == CDL_MAT_PLASTIC) {
+        float d = cdl_luminance(kd), s = cdl_luminance(b->ks);
         b->p_spec = d + s > 0.0f ? s / (d + s) : 0.0f;
     }
 }
@@ -38,6 +48,12 @@ float cdl_fresnel_dielectric(float cos_i, float eta)
     float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     return 0.5f * (rs * rs + rp * rp);
+}
+
+static int is_opaque(const cdl_bsdf *b)
+{
+    return b->type == CDL_MAT_DIFFUSE || b->type == CDL_MAT_PHONG || b->type == CDL_MAT_CONDUCTOR ||
+           b->type == CDL_MAT_PLASTIC;
 }
 
 /* Opaque materials are two-sided: both directions are mirrored to the
@@ -73,30 +89,115 @@ static float phong_lobe(float ns, cdl_vec3 lo, cdl_vec3 li, float *pdf)
     return (ns + 2.0f) * (0.5f * CDL_INV_PI) * cn;
 }
 
-cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+/* GGX reflection lobe of conductors and plastic, without Fresnel: returns
+ * D G / (4 cos_o cos_i) and its VNDF density over wi; *cos_h = wi . h. */
+static float ggx_reflect(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *pdf, float *cos_h)
+{
+    cdl_vec3 h = cdl_add(lo, li);
+    float len = cdl_length(h);
+    *pdf = 0.0f;
+    *cos_h = 0.0f;
+    if (!(len > 0.0f))
+        return 0.0f;
+    h = cdl_scale(h, 1.0f / len);
+    float d = cdl_dot(lo, h);
+    if (d <= 0.0f)
+        return 0.0f;
+    *pdf = cdl_ggx_pdf_vndf(lo, h, b->ax, b->ay) / (4.0f * d);
+    *cos_h = cdl_dot(li, h);
+    return cdl_ggx_D(h, b->ax, b->ay) * cdl_ggx_G(lo, li, b->ax, b->ay) / (4.0f * lo.z * li.z);
+}
+
+/* f and pdf of an opaque material in the flipped local frame. */
+static cdl_vec3 opaque_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *pdf)
+{
+    float pd = li.z * CDL_INV_PI, ps, cos_h;
+    cdl_vec3 f = cdl_scale(b->kd, CDL_INV_PI);
+    switch (b->type) {
+    case CDL_MAT_PHONG:
+        f = cdl_madd(f, b->ks, phong_lobe(b->ns, lo, li, &ps));
+        *pdf = (1.0f - b->p_spec) * pd + b->p_spec * ps;
+        return f;
+    case CDL_MAT_CONDUCTOR: {
+        float m = ggx_reflect(b, lo, li, pdf, &cos_h);
+        return cdl_scale(cdl_fresnel_conductor(cos_h, b->eta3, b->k3), m);
+    }
+    case CDL_MAT_PLASTIC: {
+        float m = ggx_reflect(b, lo, li, &ps, &cos_h);
+        f = cdl_madd(f, b->ks, m * cdl_fresnel_dielectric(cos_h, b->eta));
+        *pdf = (1.0f - b->p_spec) * pd + b->p_spec * ps;
+        return f;
+    }
+    default:
+        *pdf = pd;
+        return f;
+    }
+}
+
+/* Rough dielectric (Walter et al. 2007, as pbrt-v4's DielectricBxDF):
+ * f and pdf in the unflipped local frame (z = front side). */
+static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, int adjoint, float *pdf)
+{
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    *pdf = 0.0f;
+    float co = lo.z, ci = li.z;
+    if (co == 0.0f || ci == 0.0f)
+        return zero;
+    int reflect = co * ci > 0.0f;
+    float etap = reflect ? 1.0f : (co > 0.0f ? b->eta : 1.0f / b->eta);
+    cdl_vec3 wm = cdl_add(cdl_scale(li, etap), lo);
+    float len = cdl_length(wm);
+    if (!(len > 0.0f))
+        return zero;
+    wm = cdl_scale(wm, (wm.z < 0.0f ? -1.0f : 1.0f) / len);
+    float dio = cdl_dot(wm, lo), dii = cdl_dot(wm, li);
+    if (dii * ci < 0.0f || dio * co < 0.0f)
+        return zero; /* back-facing microfacet */
+    float F = cdl_fresnel_dielectric(dio, b->eta);
+    cdl_vec3 v = co > 0.0f ? lo : cdl_neg(lo); /* the viewer, on the +z side */
+    float pm = cdl_ggx_pdf_vndf(v, wm, b->ax, b->ay);
+    float D = cdl_ggx_D(wm, b->ax, b->ay), G = cdl_ggx_G(lo, li, b->ax, b->ay);
+    if (reflect) {
+        *pdf = pm / (4.0f * fabsf(dio)) * F;
+        return cdl_scale(b->ks, D * G * F / fabsf(4.0f * ci * co));
+    }
+    float denom = dii + dio / etap;
+    denom *= denom;
+    *pdf = pm * fabsf(dii) / denom * (1.0f - F);
+    float ft = D * G * (1.0f - F) * fabsf(dii * dio / (ci * co * denom));
+    if (!adjoint)
+        ft /= etap * etap;
+    return cdl_scale(b->kt, ft);
+}
+
+cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
     cdl_vec3 lo, li;
-    if (cdl_bsdf_is_delta(b) || !opaque_local(b, wo, wi, &lo, &li))
-        return cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_vec3 f = cdl_scale(b->kd, CDL_INV_PI);
-    if (b->type == CDL_MAT_PHONG) {
-        float pdf;
-        f = cdl_madd(f, b->ks, phong_lobe(b->ns, lo, li, &pdf));
+    float pdf;
+    if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
+        /* the geometric sides decide reflection vs transmission */
+        if (cdl_dot(wo, b->ng) * cdl_dot(wi, b->ng) * (cdl_to_local(&b->frame, wo).z *
+                                                       cdl_to_local(&b->frame, wi).z) < 0.0f)
+            return cdl_v3(0.0f, 0.0f, 0.0f);
+        return rough_glass_eval(b, cdl_to_local(&b->frame, wo), cdl_to_local(&b->frame, wi), adjoint, &pdf);
     }
-    return f;
+    if (!is_opaque(b) || !opaque_local(b, wo, wi, &lo, &li))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    return opaque_eval(b, lo, li, &pdf);
 }
 
 float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
-    if (cdl_bsdf_is_delta(b) || !opaque_local(b, wo, wi, &lo, &li))
+    float pdf = 0.0f;
+    if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
+        rough_glass_eval(b, cdl_to_local(&b->frame, wo), cdl_to_local(&b->frame, wi), 0, &pdf);
+        return pdf;
+    }
+    if (!is_opaque(b) || !opaque_local(b, wo, wi, &lo, &li))
         return 0.0f;
-    float pd = li.z * CDL_INV_PI;
-    if (b->type != CDL_MAT_PHONG)
-        return pd;
-    float ps;
-    phong_lobe(b->ns, lo, li, &ps);
-    return (1.0f - b->p_spec) * pd + b->p_spec * ps;
+    opaque_eval(b, lo, li, &pdf);
+    return pdf;
 }
 
 static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
@@ -111,44 +212,82 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     if (lo.z <= 0.0f)
         return 0;
     cdl_vec3 li;
-    if (u0 < b->p_spec) {
+    if (b->type == CDL_MAT_CONDUCTOR || (b->type == CDL_MAT_PLASTIC && u0 < b->p_spec)) {
+        cdl_vec3 h = cdl_ggx_sample_vndf(lo, b->ax, b->ay, u1, u2);
+        li = cdl_sub(cdl_scale(h, 2.0f * cdl_dot(lo, h)), lo);
+    } else if (b->type == CDL_MAT_PHONG && u0 < b->p_spec) {
         /* cos^n lobe around the mirror direction */
         float cos_a = powf(u1, 1.0f / (b->ns + 1.0f));
         float sin_a = sqrtf(cdl_maxf(0.0f, 1.0f - cos_a * cos_a));
         float phi = 2.0f * CDL_PI * u2;
         cdl_frame rf = cdl_frame_from(cdl_v3(-lo.x, -lo.y, lo.z));
         li = cdl_to_world(&rf, cdl_v3(sin_a * cosf(phi), sin_a * sinf(phi), cos_a));
-        if (li.z <= 0.0f)
-            return 0;
     } else {
         li = cdl_sample_cosine_hemisphere(u1, u2);
-        if (li.z <= 0.0f)
-            return 0;
     }
+    if (li.z <= 0.0f)
+        return 0;
     cdl_vec3 wi = cdl_to_world(&b->frame, cdl_v3(li.x, li.y, li.z * side));
     /* The shading frame may send wi below the geometric surface. */
     if (cdl_dot(wi, b->ng) * go <= 0.0f)
         return 0;
-    s->wi = wi;
-    s->delta = 0;
-    cdl_vec3 f = cdl_scale(b->kd, CDL_INV_PI);
-    float pdf = li.z * CDL_INV_PI;
-    if (b->type == CDL_MAT_PHONG) {
-        float ps;
-        f = cdl_madd(f, b->ks, phong_lobe(b->ns, lo, li, &ps));
-        pdf = (1.0f - b->p_spec) * pdf + b->p_spec * ps;
-    }
+    float pdf;
+    cdl_vec3 f = opaque_eval(b, lo, li, &pdf);
     if (!(pdf > 0.0f))
         return 0;
+    s->wi = wi;
+    s->delta = 0;
     s->pdf = pdf;
     s->weight = cdl_scale(f, li.z / pdf);
+    return 1;
+}
+
+static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
+                              int adjoint, cdl_scatter *s)
+{
+    cdl_vec3 lo = cdl_to_local(&b->frame, wo);
+    if (lo.z == 0.0f)
+        return 0;
+    cdl_vec3 v = lo.z > 0.0f ? lo : cdl_neg(lo);
+    cdl_vec3 wm = cdl_ggx_sample_vndf(v, b->ax, b->ay, u1, u2);
+    float dio = cdl_dot(lo, wm);
+    float F = cdl_fresnel_dielectric(dio, b->eta);
+    cdl_vec3 li;
+    if (u0 < F) {
+        li = cdl_sub(cdl_scale(wm, 2.0f * dio), lo);
+        if (li.z * lo.z <= 0.0f)
+            return 0;
+    } else {
+        /* refraction through wm; eta relative to the side wo is on */
+        float eta = dio > 0.0f ? b->eta : 1.0f / b->eta;
+        cdl_vec3 n = dio > 0.0f ? wm : cdl_neg(wm);
+        float ci = fabsf(dio);
+        float sin2_t = (1.0f - ci * ci) / (eta * eta);
+        if (sin2_t >= 1.0f)
+            return 0;
+        float ct = sqrtf(1.0f - sin2_t);
+        li = cdl_sub(cdl_scale(cdl_neg(lo), 1.0f / eta), cdl_scale(n, ct - ci / eta));
+        if (li.z * lo.z >= 0.0f)
+            return 0;
+    }
+    float pdf;
+    cdl_vec3 f = rough_glass_eval(b, lo, li, adjoint, &pdf);
+    if (!(pdf > 0.0f) || cdl_is_black(f))
+        return 0;
+    cdl_vec3 wi = cdl_normalize(cdl_to_world(&b->frame, li));
+    /* geometric and shading sides must agree on reflection vs transmission */
+    if ((cdl_dot(wi, b->ng) * cdl_dot(wo, b->ng) > 0.0f) != (li.z * lo.z > 0.0f))
+        return 0;
+    s->wi = wi;
+    s->delta = 0;
+    s->pdf = pdf;
+    s->weight = cdl_scale(f, fabsf(li.z) / pdf);
     return 1;
 }
 
 int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
                     int adjoint, cdl_scatter *s)
 {
-    (void)u2;
     if (b->type == CDL_MAT_MIRROR) {
         cdl_vec3 n = b->frame.n;
         if (cdl_dot(wo, b->ng) < 0.0f)
@@ -174,7 +313,7 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
         if (u0 < fr) {
             s->wi = cdl_reflect(wo, n);
             s->pdf = fr;
-            s->weight = cdl_v3(1.0f, 1.0f, 1.0f);
+            s->weight = b->ks;
             return 1;
         }
         float sin2_t = (1.0f - cos_o * cos_o) / (eta * eta);
@@ -185,8 +324,10 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
         s->pdf = 1.0f - fr;
         /* Radiance is compressed into the denser medium (Veach 1997, 5.2). */
         float scale = adjoint ? 1.0f : 1.0f / (eta * eta);
-        s->weight = cdl_v3(scale, scale, scale);
+        s->weight = cdl_scale(b->kt, scale);
         return 1;
     }
+    if (b->type == CDL_MAT_ROUGH_DIELECTRIC)
+        return sample_rough_glass(b, wo, u0, u1, u2, adjoint, s);
     return sample_opaque(b, wo, u0, u1, u2, s);
 }

@@ -1,7 +1,8 @@
 /* BSDFs: a material evaluated at a surface point. Directions are world
  * space unit vectors pointing away from the surface; f excludes the cosine.
  * `adjoint` selects importance transport (light paths): refraction then
- * carries no 1/eta^2 radiance scaling. */
+ * carries no 1/eta^2 radiance scaling. Opaque materials are two-sided;
+ * dielectrics are entered through the front (CCW) face. */
 #ifndef CDL_BSDF_H
 #define CDL_BSDF_H
 
@@ -9,9 +10,11 @@
 
 typedef struct cdl_bsdf {
     cdl_mat_type type;
-    cdl_vec3 kd, ks;
+    cdl_vec3 kd, ks, kt;
     float ns, eta;
-    float p_spec;    /* probability of sampling the Phong lobe */
+    cdl_vec3 eta3, k3;  /* conductor */
+    float ax, ay;       /* GGX roughness */
+    float p_spec;    /* probability of sampling the specular lobe (Phong, plastic) */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
 } cdl_bsdf;
@@ -32,7 +35,7 @@ static inline int cdl_bsdf_is_delta(const cdl_bsdf *b)
     return b->type == CDL_MAT_MIRROR || b->type == CDL_MAT_DIELECTRIC;
 }
 
-cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi);
+cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint);
 float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi);
 /* Returns 0 when no direction could be sampled (the path ends). */
 int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,

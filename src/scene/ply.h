@@ -1,0 +1,38 @@
+/* Stanford PLY triangle meshes, as referenced by pbrt's Shape "plymesh".
+ *
+ * Reads ascii 1.0, binary_little_endian 1.0 and binary_big_endian 1.0.
+ * From the "vertex" element it takes x y z, optionally nx ny nz and a
+ * texture coordinate pair (u v, s t, texture_u texture_v or texture_s
+ * texture_t); from the "face" element the vertex_indices (or vertex_index)
+ * list, fan-triangulating polygons. Every other property and element is
+ * skipped. The whole file is read into memory and parsed there.
+ *
+ * Errors name the file and, for the header and ASCII bodies, the 1-based
+ * text line; binary bodies have no lines, so their errors give line 0 and
+ * say which element is bad ("face 17: ..."). Element numbers in messages
+ * are 0-based, like the indices that refer to them. ASCII bodies must hold
+ * one element per line, as the PLY format describes. */
+#ifndef CDL_PLY_H
+#define CDL_PLY_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+
+typedef struct cdl_ply_mesh {
+    uint32_t nverts, ntris;
+    float *pos;    /* 3 per vertex */
+    float *nrm;    /* 3 per vertex, or NULL when the file has no nx ny nz */
+    float *uv;     /* 2 per vertex, or NULL (u v, s t, texture_u texture_v, texture_s texture_t) */
+    uint32_t *idx; /* 3 per triangle; polygons with n > 3 vertices are fan-triangulated */
+} cdl_ply_mesh;
+
+/* Fills m (all fields zero on failure). A file without faces is an error.
+ * Every stored number is finite with |x| <= CDL_MAX_COORD and every index
+ * is < nverts. */
+int cdl_ply_read(const char *path, cdl_ply_mesh *m, cdl_error *err);
+
+/* Frees the arrays and zeroes m; safe on a zeroed or already freed mesh. */
+void cdl_ply_free(cdl_ply_mesh *m);
+
+#endif
