@@ -36,6 +36,10 @@ typedef struct render_args {
     int nlights;
     double exposure;
     cdl_sampler_kind sampler;
+    cdl_mis_kind mis;
+    long light_paths, interleave;
+    double threshold, clamp;
+    int strata_distance;
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;
@@ -62,6 +66,16 @@ static void render_help(void)
            "      --point-light x,y,z,r,g,b   add a point light of intensity (r,g,b) W/sr;\n"
            "                          repeatable\n"
            "      --exposure EV       PNG exposure in stops (default 0)\n"
+           "\n"
+           "Bidirectional and point-light methods (bdpt, ir, rigi):\n"
+           "      --mis KIND          bdpt weights: balance, power (default) or stratified\n"
+           "      --threshold t       stratification threshold on G (default: the scene's\n"
+           "                          diagonal d gives t = 1 / (0.15 d)^2); printed when used\n"
+           "      --light-paths K     K light paths per pass shared by all pixels\n"
+           "                          (bdpt default: one per pixel sample; ir/rigi default 1024)\n"
+           "      --interleave N      N x N interleaved sets of the K paths (default 1)\n"
+           "      --clamp c           ir: clamp G at c (default: 1 / (0.05 d)^2)\n"
+           "      --strata KIND       rigi: geometry (threshold G, default) or distance\n"
            "  -q, --quiet             no warnings, no progress bar\n"
            "\n"
            "Integrators:\n");
@@ -101,6 +115,8 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
     a->fov = 40.0;
     a->maxdepth = 64;
     a->seed = 1;
+    a->mis = CDL_MIS_POWER;
+    a->interleave = 1;
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i];
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
@@ -121,7 +137,9 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
          * one that starts with '-' (so --spp -5 is an error about --spp). */
         static const char *valued[] = {"-i", "--integrator", "-o", "--output", "--spp", "--time",
                                        "--res", "--lookat", "--fov", "--maxdepth", "--seed",
-                                       "--threads", "--point-light", "--exposure", "--sampler"};
+                                       "--threads", "--point-light", "--exposure", "--sampler",
+                                       "--mis", "--light-paths", "--interleave", "--threshold",
+                                       "--clamp", "--strata"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(o, valued[k]);
@@ -178,6 +196,30 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->sampler = CDL_SAMPLER_INDEPENDENT;
             else
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected sobol or independent, got '%s'", v);
+        } else if (!strcmp(o, "--mis")) {
+            if (!strcmp(v, "balance"))
+                a->mis = CDL_MIS_BALANCE;
+            else if (!strcmp(v, "power"))
+                a->mis = CDL_MIS_POWER;
+            else if (!strcmp(v, "stratified"))
+                a->mis = CDL_MIS_STRATIFIED;
+            else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected balance, power or stratified, got '%s'", v);
+        } else if (!strcmp(o, "--light-paths")) {
+            rc = cdl_arg_int(o, v, 1, 100000000L, &a->light_paths, err);
+        } else if (!strcmp(o, "--interleave")) {
+            rc = cdl_arg_int(o, v, 1, 64, &a->interleave, err);
+        } else if (!strcmp(o, "--threshold")) {
+            rc = cdl_arg_float(o, v, 1e-12, 1e12, &a->threshold, err);
+        } else if (!strcmp(o, "--clamp")) {
+            rc = cdl_arg_float(o, v, 1e-12, 1e12, &a->clamp, err);
+        } else if (!strcmp(o, "--strata")) {
+            if (!strcmp(v, "geometry"))
+                a->strata_distance = 0;
+            else if (!strcmp(v, "distance"))
+                a->strata_distance = 1;
+            else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected geometry or distance, got '%s'", v);
         } else if (!strcmp(o, "--exposure")) {
             rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
             a->exposure = d;
@@ -187,6 +229,12 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
     }
     if (!a->scene)
         return cdl_error_set(err, CDL_ERR_USAGE, "render", 0, "no scene file given (see candela render --help)");
+    if (a->interleave > 1 && !a->light_paths)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "needs --light-paths K (the paths to interleave)");
+    if (a->light_paths && a->light_paths < a->interleave * a->interleave)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
+                             "%ld paths cannot fill %ld x %ld interleaved sets", a->light_paths,
+                             a->interleave, a->interleave);
     if (a->spp && a->time > 0.0)
         return cdl_error_set(err, CDL_ERR_USAGE, "--time", 0, "give either --spp or --time, not both");
     return 0;
@@ -280,6 +328,12 @@ int cdl_cmd_render(int argc, char **argv)
     opt.maxdepth = (int)a.maxdepth;
     opt.seed = a.seed;
     opt.sampler = a.sampler;
+    opt.mis = a.mis;
+    opt.light_paths = (uint32_t)a.light_paths;
+    opt.interleave = (uint32_t)a.interleave;
+    opt.threshold = (float)a.threshold;
+    opt.clamp = (float)a.clamp;
+    opt.strata_distance = a.strata_distance;
     if (!rc && a.has_lookat)
         rc = cdl_camera_init(&opt.camera, cdl_v3(a.lookat[0], a.lookat[1], a.lookat[2]),
                              cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),

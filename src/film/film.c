@@ -1,5 +1,6 @@
 #include "film/film.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -22,8 +23,66 @@ void cdl_film_free(cdl_film *f)
 {
     free(f->sum);
     free(f->count);
+    free(f->splat);
     f->sum = NULL;
     f->count = NULL;
+    f->splat = NULL;
+}
+
+int cdl_splats_add(cdl_splats *sp, uint32_t pixel, cdl_vec3 L)
+{
+    if (sp->n == sp->cap) {
+        uint32_t cap = sp->cap ? 2 * sp->cap : 1024;
+        uint32_t *p = realloc(sp->pixel, sizeof(uint32_t) * cap);
+        if (p)
+            sp->pixel = p;
+        float *c = realloc(sp->rgb, sizeof(float) * 3 * cap);
+        if (c)
+            sp->rgb = c;
+        if (!p || !c)
+            return -1;
+        sp->cap = cap;
+    }
+    sp->pixel[sp->n] = pixel;
+    sp->rgb[3 * sp->n] = L.x;
+    sp->rgb[3 * sp->n + 1] = L.y;
+    sp->rgb[3 * sp->n + 2] = L.z;
+    sp->n++;
+    return 0;
+}
+
+void cdl_splats_free(cdl_splats *sp)
+{
+    free(sp->pixel);
+    free(sp->rgb);
+    sp->pixel = NULL;
+    sp->rgb = NULL;
+    sp->n = sp->cap = 0;
+}
+
+uint64_t cdl_film_merge_splats(cdl_film *f, cdl_splats *sp)
+{
+    uint64_t bad = 0;
+    if (!f->splat && sp->n) {
+        f->splat = calloc(3 * (size_t)f->width * (size_t)f->height, sizeof(double));
+        if (!f->splat) {
+            sp->n = 0;
+            return 0;
+        }
+    }
+    for (uint32_t i = 0; i < sp->n; i++) {
+        const float *c = sp->rgb + 3 * (size_t)i;
+        if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
+            bad++;
+            continue;
+        }
+        double *d = f->splat + 3 * (size_t)sp->pixel[i];
+        d[0] += c[0];
+        d[1] += c[1];
+        d[2] += c[2];
+    }
+    sp->n = 0;
+    return bad;
 }
 
 int cdl_film_resolve(const cdl_film *f, cdl_image *img, cdl_error *err)
@@ -32,10 +91,12 @@ int cdl_film_resolve(const cdl_film *f, cdl_image *img, cdl_error *err)
     if (rc)
         return rc;
     size_t n = (size_t)f->width * (size_t)f->height;
+    double ws = f->splat_passes ? 1.0 / f->splat_passes : 0.0;
     for (size_t i = 0; i < n; i++) {
         double w = f->count[i] ? 1.0 / f->count[i] : 0.0;
         for (int k = 0; k < 3; k++)
-            img->rgb[3 * i + k] = (float)(f->sum[3 * i + k] * w);
+            img->rgb[3 * i + k] =
+                (float)(f->sum[3 * i + k] * w + (f->splat ? f->splat[3 * i + k] * ws : 0.0));
     }
     return 0;
 }

@@ -16,7 +16,25 @@ typedef struct cdl_film {
     uint32_t *count;    /* samples per pixel */
     uint64_t nonfinite; /* samples dropped as NaN/Inf (counted as zero) */
     uint64_t rays;      /* rays traced into this film, all threads */
+    /* Light tracing: contributions that land on any pixel, summed per pass
+     * in a fixed order and divided by the passes at the end. */
+    double *splat;      /* 3 per pixel, NULL until the first splat */
+    uint32_t splat_passes;
 } cdl_film;
+
+/* Splats gathered by one tile or one batch of light paths during a pass;
+ * merged into the film in a fixed order so that passes stay deterministic. */
+typedef struct cdl_splats {
+    uint32_t n, cap;
+    uint32_t *pixel;
+    float *rgb;
+} cdl_splats;
+
+int cdl_splats_add(cdl_splats *sp, uint32_t pixel, cdl_vec3 L);
+void cdl_splats_free(cdl_splats *sp);
+/* Adds sp to the film's splat buffer (allocating it) and empties sp.
+ * Returns the number of non-finite splats dropped. */
+uint64_t cdl_film_merge_splats(cdl_film *f, cdl_splats *sp);
 
 int cdl_film_init(cdl_film *f, int width, int height, cdl_error *err);
 void cdl_film_free(cdl_film *f);

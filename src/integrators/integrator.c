@@ -6,8 +6,9 @@
 volatile sig_atomic_t cdl_cancel = 0;
 
 extern const cdl_integrator_vtbl cdl_path_integrator;
+extern const cdl_integrator_vtbl cdl_bdpt_integrator;
 
-static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, NULL};
+static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator, NULL};
 
 void cdl_options_default(cdl_options *o)
 {
@@ -15,6 +16,16 @@ void cdl_options_default(cdl_options *o)
     o->maxdepth = 64;
     o->rr_depth = 3;
     o->seed = 1;
+    o->mis = CDL_MIS_POWER;
+    o->interleave = 1;
+}
+
+float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)
+{
+    if (opt->threshold > 0.0f)
+        return opt->threshold;
+    float r = 0.15f * cdl_length(cdl_sub(s->bmax, s->bmin));
+    return r > 0.0f ? 1.0f / (r * r) : 1.0f;
 }
 
 const cdl_integrator_vtbl *const *cdl_integrator_list(void) { return all; }

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/sampler.h"
+#include "transport/mis.h"
 #include "film/film.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -19,7 +20,19 @@ typedef struct cdl_options {
     int rr_depth;   /* Russian roulette starts after this many bounces */
     uint64_t seed;
     cdl_sampler_kind sampler; /* Sobol (default) or independent */
+
+    /* bdpt, ir, rigi (Kollig & Keller 2004) */
+    cdl_mis_kind mis;      /* bdpt weighting */
+    uint32_t light_paths;  /* K light paths per pass shared by all pixels; 0 = one per pixel sample */
+    uint32_t interleave;   /* N: N x N interleaved sets of the K paths (1 = one set) */
+    float threshold;       /* stratification threshold t on G; <= 0: derived from the scene */
+    float clamp;           /* ir: clamp G at this value; <= 0: derived from the scene */
+    int strata_distance;   /* rigi: threshold the distance instead of G (Figure 2c) */
 } cdl_options;
+
+/* The threshold t actually used: opt->threshold, or one that limits the
+ * "cheaper rays" of rigi to 15 % of the scene's diagonal (r <= sqrt(1/t)). */
+float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt);
 
 void cdl_options_default(cdl_options *o);
 

@@ -191,7 +191,11 @@ float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
     cdl_vec3 lo, li;
     float pdf = 0.0f;
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
-        rough_glass_eval(b, cdl_to_local(&b->frame, wo), cdl_to_local(&b->frame, wi), 0, &pdf);
+        lo = cdl_to_local(&b->frame, wo);
+        li = cdl_to_local(&b->frame, wi);
+        if (cdl_dot(wo, b->ng) * cdl_dot(wi, b->ng) * (lo.z * li.z) < 0.0f)
+            return 0.0f; /* the same side rule as eval and sample */
+        rough_glass_eval(b, lo, li, 0, &pdf);
         return pdf;
     }
     if (!is_opaque(b) || !opaque_local(b, wo, wi, &lo, &li))

@@ -32,4 +32,35 @@ static inline cdl_vec3 cdl_camera_ray(const cdl_camera *c, float x, float y)
     return cdl_normalize(cdl_add(c->fwd, cdl_add(cdl_scale(c->right, sx), cdl_scale(c->up, sy))));
 }
 
+/* Raster position where direction d (from the eye) lands; 0 when it
+ * points outside the image or backwards. Used by light tracing. */
+static inline int cdl_camera_raster(const cdl_camera *c, cdl_vec3 d, float *x, float *y)
+{
+    float z = cdl_dot(d, c->fwd);
+    if (z <= 0.0f)
+        return 0;
+    float sx = cdl_dot(d, c->right) / (z * cdl_dot(c->right, c->right));
+    float sy = cdl_dot(d, c->up) / (z * cdl_dot(c->up, c->up));
+    *x = 0.5f * (sx / (c->tan_half * c->aspect) + 1.0f) * (float)c->width;
+    *y = 0.5f * (1.0f - sy / c->tan_half) * (float)c->height;
+    return *x >= 0.0f && *x < (float)c->width && *y >= 0.0f && *y < (float)c->height;
+}
+
+/* Importance of the pinhole camera for unit direction d leaving the eye,
+ * normalized over the whole image: 1 / (A cos^4) with A the image's area on
+ * the plane at distance 1 (pbrt-v3's We); *pdf_dir = 1 / (A cos^3) is the
+ * density of camera rays in solid angle. Assumes a rigid camera frame. */
+static inline float cdl_camera_We(const cdl_camera *c, cdl_vec3 d, float *pdf_dir)
+{
+    float x, y;
+    *pdf_dir = 0.0f;
+    if (!cdl_camera_raster(c, d, &x, &y))
+        return 0.0f;
+    float cos_t = cdl_dot(d, c->fwd) / cdl_length(c->fwd);
+    float A = 4.0f * c->tan_half * c->tan_half * c->aspect;
+    float c2 = cos_t * cos_t;
+    *pdf_dir = 1.0f / (A * c2 * cos_t);
+    return 1.0f / (A * c2 * c2);
+}
+
 #endif

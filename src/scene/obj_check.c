@@ -53,7 +53,7 @@ void cdl_path_join_dir(const char *path, const char *name, char *out, size_t n)
     if (name[0] == '/' || !slash)
         snprintf(out, n, "%s", name);
     else
-        snprintf(out, n, "%.*s/%s", (int)(slash - path + 1), path, name);
+        snprintf(out, n, "%.*s/%s", (int)(slash - path), path, name);
 }
 
 /* A tokenizer over one line: whitespace separated words. */

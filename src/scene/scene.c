@@ -120,7 +120,9 @@ int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
     cdl_vec3 e2 = cdl_v3(pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]);
     cdl_vec3 n = cdl_cross(e1, e2);
     float len = cdl_length(n);
-    if (!(len > 0.0f) || !isfinite(len))
+    /* relative test: with fused multiply-adds the cross product of
+     * collinear edges need not cancel to exactly zero */
+    if (!(len > 1e-7f * cdl_length(e1) * cdl_length(e2)) || !isfinite(len))
         return 0;
     if (s->ntris == s->cap_tris) {
         uint32_t ci = s->cap_tris, cm = ci, ce = ci, cf = ci;

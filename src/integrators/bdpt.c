@@ -1,0 +1,215 @@
+/* bdpt: bidirectional path tracing (Veach 1997; Lafortune & Willems 1993)
+ * with every connection strategy, light tracing onto the film included.
+ *
+ * Options:
+ *   --mis balance|power|stratified  weighting; stratified is Kollig &
+ *       Keller's heuristic (a connection x_i - y_j counts where
+ *       G(x_i, y_j) < t and every earlier eye edge had G >= t)
+ *   --threshold t    for stratified (default from the scene size)
+ *   --light-paths K  K light paths per pass shared by all pixels (0: one
+ *       independent light path per pixel sample)
+ *   --interleave N   N x N interleaved sets of the K paths
+ *   --maxdepth N     bounces of the full path
+ * With K > 0 a pixel sample connects its eye path to every path of its
+ * set; MIS weights count each strategy's samples (eye 1, connections
+ * |set|, light tracing K / pixels). */
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrators/integrator.h"
+#include "transport/connect.h"
+#include "transport/light_pool.h"
+
+typedef struct bdpt_state {
+    const cdl_scene *scene;
+    cdl_options opt;
+    cdl_walk walk;
+    float threshold;
+    cdl_light_pool pool;
+    cdl_splats *tile_splats; /* one list per tile (independent mode) or per light path batch */
+    int ntiles;
+} bdpt_state;
+
+static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+{
+    bdpt_state *st = self;
+    st->scene = scene;
+    st->opt = *opt;
+    st->walk.maxdepth = opt->maxdepth;
+    st->walk.rr_depth = opt->rr_depth;
+    st->threshold = cdl_default_threshold(scene, opt);
+    for (uint32_t i = 0; i < scene->nlights; i++)
+        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
+            return CDL_ERR_INPUT; /* reported by the caller */
+    cdl_error err;
+    if (opt->light_paths && cdl_light_pool_init(&st->pool, opt->light_paths, opt->interleave,
+                                                opt->maxdepth, &err))
+        return err.code;
+    int tx = (opt->camera.width + 15) / 16, ty = (opt->camera.height + 15) / 16;
+    st->ntiles = tx * ty;
+    int nlists = st->ntiles > 1024 ? st->ntiles : 1024;
+    st->tile_splats = calloc((size_t)nlists, sizeof(cdl_splats));
+    return st->tile_splats ? 0 : CDL_ERR_SYSTEM;
+}
+
+/* All strategies of one eye subpath against one light subpath (the light
+ * path's vertices are light[0 .. nl), indices into lvs). */
+static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint32_t ne,
+                        const cdl_vertex_store *lvs, uint32_t l0, uint32_t nl,
+                        const cdl_mis_counts *cnt, int with_eye_only, cdl_splats *splats,
+                        float splat_scale, uint64_t *rays)
+{
+    const cdl_scene *s = st->scene;
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_connect_ctx cx = {s, &st->opt.camera, st->opt.mis, st->threshold, cnt};
+    for (uint32_t t = 1; t <= ne; t++) {
+        for (uint32_t sidx = with_eye_only ? 0 : 1; sidx <= nl; sidx++) {
+            if (sidx + t < 2 || (int)(sidx + t) - 2 > st->opt.maxdepth)
+                continue;
+            if (t == 1) {
+                /* s = 1, t = 1 would repeat the light seen directly (s = 0, t = 2) */
+                if (sidx < 2 || !splats)
+                    continue;
+                float x, y;
+                cdl_vec3 c = cdl_connect_camera(&cx, lvs, l0, sidx, &x, &y, rays);
+                if (!cdl_is_black(c)) {
+                    int px = (int)x, py = (int)y;
+                    cdl_splats_add(splats, (uint32_t)py * (uint32_t)st->opt.camera.width + (uint32_t)px,
+                                   cdl_scale(c, splat_scale));
+                }
+                continue;
+            }
+            if (sidx == 0) {
+                if (with_eye_only)
+                    L = cdl_add(L, cdl_connect_eye_only(&cx, evs, t));
+                continue;
+            }
+            L = cdl_add(L, cdl_connect(&cx, evs, t, lvs, l0, sidx, rays));
+        }
+    }
+    return L;
+}
+
+static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, int y1,
+                          uint32_t pass, uint64_t *rays)
+{
+    bdpt_state *st = self;
+    const cdl_camera *cam = &st->opt.camera;
+    uint32_t room = (uint32_t)st->opt.maxdepth + 3;
+    cdl_vertex_store evs, lvs;
+    cdl_vs_init(&evs);
+    cdl_vs_init(&lvs);
+    cdl_error err;
+    if (cdl_vs_reserve(&evs, room, &err) || cdl_vs_reserve(&lvs, room, &err))
+        return 0;
+    int tile = (y0 / 16) * ((film->width + 15) / 16) + x0 / 16;
+    cdl_splats *splats = &st->tile_splats[tile];
+    uint64_t bad = 0;
+    uint64_t npix = (uint64_t)film->width * (uint64_t)film->height;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            uint64_t pix = (uint64_t)y * (uint64_t)film->width + (uint64_t)x;
+            cdl_sampler smp;
+            float jx, jy;
+            cdl_sampler_start(&smp, st->opt.sampler, st->opt.seed, pix, pass);
+            cdl_sampler_2d(&smp, &jx, &jy);
+            cdl_vs_clear(&evs);
+            uint32_t ne = cdl_trace_eye_subpath(st->scene, cam, (float)x + jx, (float)y + jy, &st->walk,
+                                                &smp, &evs, rays);
+            cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+            if (!st->opt.light_paths) {
+                cdl_sampler lsmp;
+                cdl_sampler_start(&lsmp, st->opt.sampler, st->opt.seed, pix + npix, pass);
+                cdl_vs_clear(&lvs);
+                uint32_t nl = cdl_trace_light_subpath(st->scene, &st->walk, &lsmp, &lvs, rays);
+                cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f};
+                L = combine(st, &evs, ne, &lvs, 0, nl, &cnt, 1, splats, 1.0f, rays);
+            } else {
+                const cdl_light_pool *lp = &st->pool;
+                uint32_t set = cdl_light_pool_set(lp, x, y), m = cdl_light_pool_set_size(lp, set);
+                cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m};
+                /* pure eye paths once, connections to each path of the set */
+                L = combine(st, &evs, ne, &lvs, 0, 0, &cnt, 1, NULL, 0.0f, rays);
+                cdl_vec3 Lc = cdl_v3(0.0f, 0.0f, 0.0f);
+                for (uint32_t k = set; k < lp->k; k += lp->sets)
+                    Lc = cdl_add(Lc, combine(st, &evs, ne, &lp->vs, k * lp->stride, lp->len[k], &cnt, 0,
+                                             NULL, 0.0f, rays));
+                if (m)
+                    L = cdl_add(L, cdl_scale(Lc, 1.0f / (float)m));
+            }
+            bad += (uint64_t)cdl_film_add(film, x, y, L);
+        }
+    cdl_vs_free(&evs);
+    cdl_vs_free(&lvs);
+    return bad;
+}
+
+/* Reused light paths: each of the K paths is traced onto the film once
+ * per pass (t = 1), scaled to one light path per pixel. */
+static void light_trace_pool(bdpt_state *st, cdl_film *film)
+{
+    const cdl_light_pool *lp = &st->pool;
+    uint64_t npix = (uint64_t)film->width * (uint64_t)film->height, rays = 0;
+    cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, 1.0f};
+    float scale = (float)npix / (float)lp->k;
+    int nbatch = 1024;
+    cdl_vertex_store none;
+    cdl_vs_init(&none);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays)
+    for (int b = 0; b < nbatch; b++) {
+        for (uint32_t k = (uint32_t)b; k < lp->k; k += (uint32_t)nbatch) {
+            uint32_t set = k % lp->sets;
+            cdl_mis_counts c = cnt;
+            c.connect = (float)cdl_light_pool_set_size(lp, set);
+            uint64_t r = 0;
+            combine(st, &none, 1, &lp->vs, k * lp->stride, lp->len[k], &c, 0, &st->tile_splats[b], scale, &r);
+            rays += r;
+        }
+    }
+    film->rays += rays;
+}
+
+static int bdpt_render_pass(void *self, cdl_film *film, uint32_t pass)
+{
+    bdpt_state *st = self;
+    if (st->opt.light_paths) {
+        cdl_light_pool_trace(&st->pool, st->scene, &st->walk, st->opt.sampler, st->opt.seed, pass,
+                             &film->rays);
+    }
+    cdl_render_tiles(self, film, pass, bdpt_tile);
+    if (st->opt.light_paths && !cdl_cancel)
+        light_trace_pool(st, film);
+    int nlists = st->ntiles > 1024 ? st->ntiles : 1024;
+    if (cdl_cancel) {
+        for (int i = 0; i < nlists; i++)
+            st->tile_splats[i].n = 0; /* an interrupted pass's splats are incomplete */
+        return 0;
+    }
+    for (int i = 0; i < nlists; i++)
+        film->nonfinite += cdl_film_merge_splats(film, &st->tile_splats[i]);
+    film->splat_passes++;
+    return 0;
+}
+
+static void bdpt_destroy(void *self)
+{
+    bdpt_state *st = self;
+    if (st->tile_splats) {
+        int nlists = st->ntiles > 1024 ? st->ntiles : 1024;
+        for (int i = 0; i < nlists; i++)
+            cdl_splats_free(&st->tile_splats[i]);
+        free(st->tile_splats);
+    }
+    if (st->opt.light_paths)
+        cdl_light_pool_free(&st->pool);
+}
+
+const cdl_integrator_vtbl cdl_bdpt_integrator = {
+    .name = "bdpt",
+    .summary = "bidirectional path tracing, all strategies incl. light tracing; --mis, --light-paths, --interleave",
+    .prepare = bdpt_prepare,
+    .render_pass = bdpt_render_pass,
+    .destroy = bdpt_destroy,
+    .self_size = sizeof(bdpt_state),
+};

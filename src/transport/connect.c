@@ -1,0 +1,238 @@
+#include "transport/connect.h"
+
+#include "transport/subpath.h"
+
+#define MAX_PATH 1100 /* > maxdepth limit (1024) + 3 */
+
+float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
+{
+    switch (l->type) {
+    case CDL_LIGHT_POINT:
+        return 1.0f;
+    case CDL_LIGHT_SPOT: {
+        float c = cdl_dot(w, l->n);
+        if (c < l->cos_total)
+            return 0.0f;
+        if (c >= l->cos_falloff)
+            return 1.0f;
+        float d = (c - l->cos_total) / (l->cos_falloff - l->cos_total);
+        return (d * d) * (d * d);
+    }
+    case CDL_LIGHT_TRIANGLE:
+    case CDL_LIGHT_SPHERE:
+        return cdl_is_black(cdl_light_Le(l, n, w)) ? 0.0f : 1.0f;
+    default:
+        return 0.0f;
+    }
+}
+
+int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb)
+{
+    cdl_vec3 d = cdl_sub(pb, pa);
+    cdl_vec3 o = cdl_is_black(na) ? pa : cdl_offset(s, pa, na, d);
+    cdl_vec3 e = cdl_is_black(nb) ? pb : cdl_offset(s, pb, nb, cdl_neg(d));
+    cdl_vec3 de = cdl_sub(e, o);
+    float len = cdl_length(de);
+    if (!(len > 0.0f))
+        return 1;
+    return !cdl_occluded(s, o, cdl_scale(de, 1.0f / len), len);
+}
+
+/* Normal used for area-density conversions and cosines: none for the
+ * camera and for point and spot lights. */
+static cdl_vec3 vnormal(const cdl_vertex_store *vs, uint32_t i)
+{
+    if (vs->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    return vs->ng[i];
+}
+
+static cdl_vec3 vshading(const cdl_vertex_store *vs, uint32_t i)
+{
+    if (vs->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    return vs->ns[i];
+}
+
+/* Area density at `to` (normal nt) of sampling it from vertex i, which was
+ * reached from position `from` (ignored for the camera and lights). */
+static float vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                        cdl_vec3 from, cdl_vec3 to, cdl_vec3 nt)
+{
+    cdl_vec3 p = vs->p[i];
+    cdl_vec3 w = cdl_sub(to, p);
+    float len = cdl_length(w);
+    if (!(len > 0.0f))
+        return 0.0f;
+    w = cdl_scale(w, 1.0f / len);
+    float pdf_sa;
+    if (vs->flags[i] & CDL_V_CAMERA) {
+        cdl_camera_We(cx->cam, w, &pdf_sa);
+    } else if (vs->flags[i] & CDL_V_LIGHT) {
+        pdf_sa = cdl_light_pdf_dir(&cx->scene->lights[vs->light[i]], vs->ng[i], w);
+    } else {
+        cdl_bsdf b;
+        cdl_vs_bsdf(cx->scene, vs, i, &b);
+        pdf_sa = cdl_bsdf_pdf(&b, cdl_normalize(cdl_sub(from, p)), w);
+    }
+    return cdl_pdf_to_area(pdf_sa, p, to, nt);
+}
+
+/* f at vertex i for light arriving from `from` and leaving to `to` (eye
+ * vertices: radiance mode; light vertices: importance mode with Veach's
+ * shading-normal correction; y_0: the emission distribution). */
+static cdl_vec3 vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                         cdl_vec3 from, cdl_vec3 to, int light_side)
+{
+    cdl_vec3 p = vs->p[i];
+    cdl_vec3 wt = cdl_normalize(cdl_sub(to, p));
+    if (vs->flags[i] & CDL_V_LIGHT) {
+        float k = cdl_light_emit_factor(&cx->scene->lights[vs->light[i]], vs->ng[i], wt);
+        return cdl_v3(k, k, k);
+    }
+    cdl_vec3 wf = cdl_normalize(cdl_sub(from, p));
+    cdl_bsdf b;
+    cdl_vs_bsdf(cx->scene, vs, i, &b);
+    if (!light_side)
+        return cdl_bsdf_eval(&b, wf, wt, 0);
+    cdl_vec3 f = cdl_bsdf_eval(&b, wf, wt, 1);
+    float num = fabsf(cdl_dot(wf, vs->ns[i])) * fabsf(cdl_dot(wt, vs->ng[i]));
+    float den = fabsf(cdl_dot(wf, vs->ng[i])) * fabsf(cdl_dot(wt, vs->ns[i]));
+    return cdl_scale(f, den > 0.0f ? num / den : 0.0f);
+}
+
+/* MIS records of the full path: eye vertices 0..t-1, then light vertices
+ * s-1..0 (indices l0 + j). */
+static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_t t,
+                         const cdl_vertex_store *lvs, uint32_t l0, uint32_t s, int need_g)
+{
+    for (uint32_t k = 0; k < t; k++) {
+        v[k].pdf_eye = evs->pdf_fwd[k];
+        v[k].pdf_light = evs->pdf_rev[k];
+        v[k].delta = (evs->flags[k] & CDL_V_DELTA) != 0;
+        v[k].g_next = 0.0f;
+        if (need_g && k + 1 < t)
+            v[k].g_next = cdl_geometry(evs->p[k], vnormal(evs, k), evs->p[k + 1], vnormal(evs, k + 1));
+    }
+    for (uint32_t j = 0; j < s; j++) {
+        uint32_t k = s + t - 1 - j, i = l0 + j;
+        v[k].pdf_eye = lvs->pdf_rev[i];
+        v[k].pdf_light = lvs->pdf_fwd[i];
+        v[k].delta = (lvs->flags[i] & CDL_V_DELTA) != 0;
+        v[k].g_next = 0.0f;
+    }
+}
+
+cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t)
+{
+    uint32_t i = t - 1;
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    if (!(evs->flags[i] & CDL_V_EMITTER))
+        return zero;
+    const cdl_light *l = &cx->scene->lights[evs->light[i]];
+    cdl_vec3 Le = cdl_light_Le(l, evs->ng[i], evs->wi[i]);
+    if (cdl_is_black(Le))
+        return zero;
+    cdl_vec3 c = cdl_mul(evs->beta[i], Le);
+    if (t == 2 && cx->mis != CDL_MIS_STRATIFIED)
+        return c;
+    cdl_mis_vertex v[MAX_PATH];
+    if (t > MAX_PATH)
+        return zero;
+    fill_records(v, evs, t, NULL, 0, 0, cx->mis == CDL_MIS_STRATIFIED);
+    v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
+    v[i - 1].pdf_light = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[i], evs->wi[i]), evs->p[i],
+                                         evs->p[i - 1], vnormal(evs, i - 1));
+    v[i].delta = 0;
+    return cdl_scale(c, cdl_mis_weight(cx->mis, v, 0, (int)t, 0, cx->counts, cx->threshold));
+}
+
+cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t,
+                     const cdl_vertex_store *lvs, uint32_t l0, uint32_t s, uint64_t *rays)
+{
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    uint32_t pt = t - 1, qs = l0 + s - 1;
+    if ((evs->flags[pt] & CDL_V_DELTA) || (lvs->flags[qs] & CDL_V_DELTA) || s + t > MAX_PATH)
+        return zero;
+    cdl_vec3 pp = evs->p[pt], qp = lvs->p[qs];
+    cdl_vec3 pm = evs->p[pt - 1];
+    cdl_vec3 qm = s >= 2 ? lvs->p[qs - 1] : qp;
+    cdl_vec3 fe = vertex_f(cx, evs, pt, pm, qp, 0);
+    if (cdl_is_black(fe))
+        return zero;
+    cdl_vec3 fl = vertex_f(cx, lvs, qs, qm, pp, 1);
+    if (cdl_is_black(fl))
+        return zero;
+    float G = cdl_geometry(pp, vshading(evs, pt), qp, vshading(lvs, qs));
+    cdl_vec3 c = cdl_mul(cdl_mul(evs->beta[pt], fe), cdl_mul(lvs->beta[qs], fl));
+    c = cdl_scale(c, G);
+    if (cdl_is_black(c))
+        return zero;
+    cdl_mis_vertex v[MAX_PATH];
+    int strat = cx->mis == CDL_MIS_STRATIFIED;
+    fill_records(v, evs, t, lvs, l0, s, strat);
+    cdl_vec3 np = vnormal(evs, pt), nq = vnormal(lvs, qs);
+    v[pt].g_next = cdl_geometry(pp, np, qp, nq);
+    /* densities through the new edge, both ways (pbrt-v3's MISWeight) */
+    v[pt].pdf_light = vertex_pdf(cx, lvs, qs, qm, pp, np);
+    v[pt - 1].pdf_light = vertex_pdf(cx, evs, pt, qp, pm, vnormal(evs, pt - 1));
+    v[t].pdf_eye = vertex_pdf(cx, evs, pt, pm, qp, nq);
+    if (s >= 2)
+        v[t + 1].pdf_eye = vertex_pdf(cx, lvs, qs, pp, qm, vnormal(lvs, qs - 1));
+    v[pt].delta = v[t].delta = 0;
+    int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
+    float w = cdl_mis_weight(cx->mis, v, (int)s, (int)t, delta_light, cx->counts, cx->threshold);
+    if (w <= 0.0f)
+        return zero;
+    (*rays)++;
+    if (!cdl_visible(cx->scene, pp, np, qp, nq))
+        return zero;
+    return cdl_scale(c, w);
+}
+
+cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0,
+                            uint32_t s, float *x, float *y, uint64_t *rays)
+{
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    uint32_t qs = l0 + s - 1;
+    if (s < 2 || (lvs->flags[qs] & CDL_V_DELTA) || s + 1 > MAX_PATH)
+        return zero;
+    const cdl_camera *cam = cx->cam;
+    cdl_vec3 qp = lvs->p[qs], qm = lvs->p[qs - 1];
+    cdl_vec3 d = cdl_sub(qp, cam->eye);
+    float d2 = cdl_dot(d, d);
+    if (!(d2 > 0.0f))
+        return zero;
+    cdl_vec3 w = cdl_scale(d, 1.0f / sqrtf(d2));
+    if (!cdl_camera_raster(cam, w, x, y))
+        return zero;
+    float pdf_cam;
+    float We = cdl_camera_We(cam, w, &pdf_cam);
+    float cos_cam = cdl_dot(w, cam->fwd) / cdl_length(cam->fwd);
+    cdl_vec3 fl = vertex_f(cx, lvs, qs, qm, cam->eye, 1);
+    float cos_q = fabsf(cdl_dot(w, lvs->ns[qs]));
+    cdl_vec3 c = cdl_scale(cdl_mul(lvs->beta[qs], fl), We * cos_cam / d2 * cos_q);
+    if (cdl_is_black(c))
+        return zero;
+    cdl_mis_vertex v[MAX_PATH];
+    fill_records(v, NULL, 0, lvs, l0, s, 0);
+    /* shift: record 0 is the camera */
+    for (uint32_t k = s; k > 0; k--)
+        v[k] = v[k - 1];
+    v[0].pdf_eye = 1.0f;
+    v[0].pdf_light = 0.0f;
+    v[0].delta = 0;
+    v[0].g_next = 0.0f;
+    cdl_vec3 nq = vnormal(lvs, qs);
+    v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
+    v[2].pdf_eye = vertex_pdf(cx, lvs, qs, cam->eye, qm, vnormal(lvs, qs - 1));
+    v[1].delta = 0;
+    int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
+    float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, cx->counts, cx->threshold);
+    if (wgt <= 0.0f)
+        return zero;
+    (*rays)++;
+    if (!cdl_visible(cx->scene, cam->eye, cdl_v3(0.0f, 0.0f, 0.0f), qp, nq))
+        return zero;
+    return cdl_scale(c, wgt);
+}

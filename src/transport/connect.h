@@ -1,0 +1,54 @@
+/* Connecting an eye subpath and a light subpath: the contribution of one
+ * bidirectional strategy (s, t) with its MIS weight. Shared by bdpt and
+ * the point-light methods (ir, rigi). */
+#ifndef CDL_CONNECT_H
+#define CDL_CONNECT_H
+
+#include "scene/camera.h"
+#include "transport/mis.h"
+#include "transport/vertex_store.h"
+
+typedef struct cdl_connect_ctx {
+    const cdl_scene *scene;
+    const cdl_camera *cam;
+    cdl_mis_kind mis;
+    float threshold;            /* stratification heuristic's t */
+    const cdl_mis_counts *counts;
+} cdl_connect_ctx;
+
+/* s = 0: the eye path's vertex t-1 lies on a light; Le there, weighted. */
+cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t);
+
+/* s >= 1, t >= 2: eye vertex t-1 (of evs, from index 0) to light vertex
+ * s-1 (of lvs, path starting at index l0), shadow ray included. */
+cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t,
+                     const cdl_vertex_store *lvs, uint32_t l0, uint32_t s, uint64_t *rays);
+
+/* t = 1, s >= 2: light vertex s-1 seen by the camera; returns the value to
+ * splat at raster (*x, *y) (already weighted), or black. */
+cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0,
+                            uint32_t s, float *x, float *y, uint64_t *rays);
+
+/* G = |cos a| |cos b| / d^2 with geometric... shading normals na, nb
+ * (zero normal: a point, cosine 1). */
+static inline float cdl_geometry(cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb)
+{
+    cdl_vec3 d = cdl_sub(pb, pa);
+    float d2 = cdl_dot(d, d);
+    if (!(d2 > 0.0f))
+        return 0.0f;
+    float inv = 1.0f / sqrtf(d2);
+    float ca = cdl_is_black(na) ? 1.0f : fabsf(cdl_dot(na, d)) * inv;
+    float cb = cdl_is_black(nb) ? 1.0f : fabsf(cdl_dot(nb, d)) * inv;
+    return ca * cb / d2;
+}
+
+/* 1 if nothing blocks the segment between two vertices (offset off their
+ * surfaces; a zero normal marks a point that needs no offset). */
+int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb);
+
+/* The fraction of a light's emission y_0 sends towards unit w: 1 or 0
+ * for diffuse area lights, the falloff for spots, 1 for points. */
+float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w);
+
+#endif

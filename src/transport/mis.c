@@ -1,0 +1,64 @@
+#include "transport/mis.h"
+
+#include <math.h>
+
+static float remap0(float x) { return x != 0.0f ? x : 1.0f; }
+
+/* x^beta for the two heuristics: powf is needlessly slow here */
+static float hpow(float x, int power) { return power ? x * x : x; }
+
+static float count(const cdl_mis_counts *n, int s, int t)
+{
+    return s == 0 ? n->eye : (t == 1 ? n->light_trace : n->connect);
+}
+
+/* §3.2: the strategy whose connecting edge is the first edge, counted
+ * from z_1, with G below the threshold. Edges at delta vertices cannot be
+ * connected and are skipped; a path ending on a delta light must be
+ * connected at its last edge; a path without such an edge is left to the
+ * eye path alone (s = 0). */
+static float stratified(const cdl_mis_vertex *v, int s, int t, int delta_light, float thr)
+{
+    int L = s + t - 1;
+    int designated = -1; /* edge (z_k, z_k+1) */
+    int last = s == 0 ? L - 1 : t - 1; /* edges past the connection cannot matter */
+    for (int k = 1; k <= last; k++) {
+        if (v[k].delta || v[k + 1].delta)
+            continue;
+        if (v[k].g_next < thr || (k + 1 == L && delta_light)) {
+            designated = k;
+            break;
+        }
+    }
+    if (s == 0)
+        return designated < 0 ? 1.0f : 0.0f;
+    if (t == 1)
+        return 0.0f;
+    return designated == t - 1 ? 1.0f : 0.0f;
+}
+
+float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, int delta_light,
+                     const cdl_mis_counts *n, float threshold)
+{
+    if (kind == CDL_MIS_STRATIFIED)
+        return stratified(v, s, t, delta_light, threshold);
+    if (s + t == 2)
+        return 1.0f;
+    int pw = kind == CDL_MIS_POWER;
+    float here = count(n, s, t), sum = 0.0f, r = 1.0f;
+    /* moving the connection towards the camera: fewer eye vertices */
+    for (int i = t - 1; i > 0; i--) {
+        r *= hpow(remap0(v[i].pdf_light) / remap0(v[i].pdf_eye), pw);
+        if (!v[i].delta && !v[i - 1].delta)
+            sum += r * hpow(count(n, s + t - i, i) / here, pw);
+    }
+    /* towards the light: fewer light vertices */
+    r = 1.0f;
+    for (int i = t; i < s + t; i++) {
+        r *= hpow(remap0(v[i].pdf_eye) / remap0(v[i].pdf_light), pw);
+        int delta_prev = i + 1 < s + t ? v[i + 1].delta : delta_light;
+        if (!v[i].delta && !delta_prev)
+            sum += r * hpow(count(n, s + t - i - 1, i + 1) / here, pw);
+    }
+    return 1.0f / (1.0f + sum);
+}

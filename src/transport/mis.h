@@ -1,0 +1,34 @@
+/* Multiple importance sampling weights of bidirectional strategies
+ * (Veach 1997, ch. 10; pbrt-v3's MISWeight), and the stratification
+ * heuristic of Kollig & Keller 2004 (§3.2).
+ *
+ * A full path is z_0 ... z_{L}: z_0 the camera, z_L on a light. Strategy
+ * (s, t) takes t vertices from the eye subpath and s from the light
+ * subpath. The caller fills one record per vertex of the full path, in
+ * eye-to-light order, with densities already updated for the connection. */
+#ifndef CDL_MIS_H
+#define CDL_MIS_H
+
+typedef enum cdl_mis_kind { CDL_MIS_BALANCE, CDL_MIS_POWER, CDL_MIS_STRATIFIED } cdl_mis_kind;
+
+typedef struct cdl_mis_vertex {
+    float pdf_eye;   /* area density of this vertex sampled from the eye side (from z_{k-1}) */
+    float pdf_light; /* area density sampled from the light side (from z_{k+1}; z_L: light origin) */
+    int delta;       /* cannot be connected to */
+    float g_next;    /* stratification: G(z_k, z_{k+1}) */
+} cdl_mis_vertex;
+
+/* Samples each strategy takes per eye sample: pure eye paths (s = 0),
+ * light tracing (t = 1) and the connections in between. Independent
+ * subpaths per pixel sample use 1 for all three. */
+typedef struct cdl_mis_counts {
+    float eye, light_trace, connect;
+} cdl_mis_counts;
+
+/* Weight of strategy (s, t) for the full path v[0 .. s+t-1].
+ * delta_light: z_L is a point or spot light (an eye path cannot hit it).
+ * threshold: the stratification heuristic's t. */
+float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, int delta_light,
+                     const cdl_mis_counts *n, float threshold);
+
+#endif
