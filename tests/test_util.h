@@ -44,10 +44,14 @@ static inline void render_film(const char *integrator, const cdl_scene *s, const
     cdl_integrator_destroy(&it);
 }
 
+/* As cdl_film_resolve: the pixel's own samples plus light-tracing splats. */
 static inline double film_pixel(const cdl_film *f, int x, int y, int c)
 {
     size_t i = (size_t)y * (size_t)f->width + (size_t)x;
-    return f->sum[3 * i + c] / f->count[i];
+    double v = f->sum[3 * i + c] / f->count[i];
+    if (f->splat && f->splat_passes)
+        v += f->splat[3 * i + c] / f->splat_passes;
+    return v;
 }
 
 #endif

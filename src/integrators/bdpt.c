@@ -10,6 +10,7 @@
  *       independent light path per pixel sample)
  *   --interleave N   N x N interleaved sets of the K paths
  *   --maxdepth N     bounces of the full path
+ * Without K, s = 1 resamples a light point per eye vertex (as pbrt-v3).
  * With K > 0 a pixel sample connects its eye path to every path of its
  * set; MIS weights count each strategy's samples (eye 1, connections
  * |set|, light tracing K / pixels). */
@@ -53,16 +54,66 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     return st->tile_splats ? 0 : CDL_ERR_SYSTEM;
 }
 
+/* s = 1 by resampling a light point for eye vertex pt (pbrt-v3 does the
+ * same): next-event estimation's sampling (solid angle for spheres) gives
+ * far less noise than the light subpath's y_0. The temporary vertex
+ * carries 1 / (its actual density) as throughput but the light-path
+ * origin density for MIS, so the weights stay a partition of unity. */
+static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *cx,
+                                  const cdl_vertex_store *evs, uint32_t t, cdl_sampler *smp,
+                                  cdl_vertex_store *tmp, uint64_t *rays)
+{
+    const cdl_scene *s = st->scene;
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    float us, ua, u1, u2, pmf;
+    smp->dim = 2 * t; /* same dimensions at the same depth in every pass: stays stratified */
+    cdl_sampler_2d(smp, &us, &ua);
+    cdl_sampler_2d(smp, &u1, &u2);
+    uint32_t pt = t - 1;
+    if (evs->flags[pt] & CDL_V_DELTA)
+        return zero;
+    uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
+    const cdl_light *l = &s->lights[li];
+    cdl_light_sample ls;
+    if (!cdl_light_sample_li(l, evs->p[pt], u1, u2, &ls))
+        return zero;
+    cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f);
+    float pdf_area = ls.pdf; /* delta lights: 1 */
+    if (l->type == CDL_LIGHT_TRIANGLE || l->type == CDL_LIGHT_SPHERE) {
+        n = l->type == CDL_LIGHT_TRIANGLE ? l->n : cdl_normalize(cdl_sub(ls.p, l->p));
+        if (l->type == CDL_LIGHT_SPHERE && l->inward)
+            n = cdl_neg(n);
+        float c = fabsf(cdl_dot(n, ls.wi));
+        pdf_area = ls.pdf * c / (ls.dist * ls.dist);
+    }
+    if (!(pdf_area > 0.0f))
+        return zero;
+    cdl_vs_clear(tmp);
+    tmp->n = 1;
+    tmp->p[0] = ls.p;
+    tmp->ng[0] = tmp->ns[0] = n;
+    tmp->wi[0] = zero;
+    tmp->beta[0] = cdl_scale(l->L, 1.0f / (pmf * pdf_area));
+    tmp->pdf_fwd[0] = cdl_light_pdf_origin(s, (int32_t)li);
+    tmp->pdf_rev[0] = 0.0f;
+    tmp->parent[0] = -1;
+    tmp->light[0] = (int32_t)li;
+    tmp->depth[0] = 0;
+    tmp->flags[0] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0);
+    return cdl_connect(cx, evs, t, tmp, 0, 1, rays);
+}
+
 /* All strategies of one eye subpath against one light subpath (the light
  * path's vertices are light[0 .. nl), indices into lvs). */
 static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint32_t ne,
                         const cdl_vertex_store *lvs, uint32_t l0, uint32_t nl,
                         const cdl_mis_counts *cnt, int with_eye_only, cdl_splats *splats,
-                        float splat_scale, uint64_t *rays)
+                        float splat_scale, cdl_sampler *resample, cdl_vertex_store *tmp,
+                        uint64_t *rays)
 {
     const cdl_scene *s = st->scene;
     cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_connect_ctx cx = {s, &st->opt.camera, st->opt.mis, st->threshold, cnt};
+    cdl_connect_ctx cx = {s, &st->opt.camera, st->opt.mis, st->threshold, cnt, resample != NULL};
     for (uint32_t t = 1; t <= ne; t++) {
         for (uint32_t sidx = with_eye_only ? 0 : 1; sidx <= nl; sidx++) {
             if (sidx + t < 2 || (int)(sidx + t) - 2 > st->opt.maxdepth)
@@ -85,7 +136,10 @@ static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint3
                     L = cdl_add(L, cdl_connect_eye_only(&cx, evs, t));
                 continue;
             }
-            L = cdl_add(L, cdl_connect(&cx, evs, t, lvs, l0, sidx, rays));
+            if (sidx == 1 && resample)
+                L = cdl_add(L, connect_resampled(st, &cx, evs, t, resample, tmp, rays));
+            else
+                L = cdl_add(L, cdl_connect(&cx, evs, t, lvs, l0, sidx, rays));
         }
     }
     return L;
@@ -97,11 +151,13 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     bdpt_state *st = self;
     const cdl_camera *cam = &st->opt.camera;
     uint32_t room = (uint32_t)st->opt.maxdepth + 3;
-    cdl_vertex_store evs, lvs;
+    cdl_vertex_store evs, lvs, tvs;
     cdl_vs_init(&evs);
     cdl_vs_init(&lvs);
+    cdl_vs_init(&tvs);
     cdl_error err;
-    if (cdl_vs_reserve(&evs, room, &err) || cdl_vs_reserve(&lvs, room, &err))
+    if (cdl_vs_reserve(&evs, room, &err) || cdl_vs_reserve(&lvs, room, &err) ||
+        cdl_vs_reserve(&tvs, 1, &err))
         return 0;
     int tile = (y0 / 16) * ((film->width + 15) / 16) + x0 / 16;
     cdl_splats *splats = &st->tile_splats[tile];
@@ -124,17 +180,19 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                 cdl_vs_clear(&lvs);
                 uint32_t nl = cdl_trace_light_subpath(st->scene, &st->walk, &lsmp, &lvs, rays);
                 cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f};
-                L = combine(st, &evs, ne, &lvs, 0, nl, &cnt, 1, splats, 1.0f, rays);
+                cdl_sampler rsmp;
+                cdl_sampler_start(&rsmp, st->opt.sampler, st->opt.seed, pix + 2 * npix, pass);
+                L = combine(st, &evs, ne, &lvs, 0, nl, &cnt, 1, splats, 1.0f, &rsmp, &tvs, rays);
             } else {
                 const cdl_light_pool *lp = &st->pool;
                 uint32_t set = cdl_light_pool_set(lp, x, y), m = cdl_light_pool_set_size(lp, set);
                 cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m};
                 /* pure eye paths once, connections to each path of the set */
-                L = combine(st, &evs, ne, &lvs, 0, 0, &cnt, 1, NULL, 0.0f, rays);
+                L = combine(st, &evs, ne, &lvs, 0, 0, &cnt, 1, NULL, 0.0f, NULL, NULL, rays);
                 cdl_vec3 Lc = cdl_v3(0.0f, 0.0f, 0.0f);
                 for (uint32_t k = set; k < lp->k; k += lp->sets)
                     Lc = cdl_add(Lc, combine(st, &evs, ne, &lp->vs, k * lp->stride, lp->len[k], &cnt, 0,
-                                             NULL, 0.0f, rays));
+                                             NULL, 0.0f, NULL, NULL, rays));
                 if (m)
                     L = cdl_add(L, cdl_scale(Lc, 1.0f / (float)m));
             }
@@ -142,6 +200,7 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
         }
     cdl_vs_free(&evs);
     cdl_vs_free(&lvs);
+    cdl_vs_free(&tvs);
     return bad;
 }
 
@@ -163,7 +222,8 @@ static void light_trace_pool(bdpt_state *st, cdl_film *film)
             cdl_mis_counts c = cnt;
             c.connect = (float)cdl_light_pool_set_size(lp, set);
             uint64_t r = 0;
-            combine(st, &none, 1, &lp->vs, k * lp->stride, lp->len[k], &c, 0, &st->tile_splats[b], scale, &r);
+            combine(st, &none, 1, &lp->vs, k * lp->stride, lp->len[k], &c, 0, &st->tile_splats[b], scale,
+                    NULL, NULL, &r);
             rays += r;
         }
     }

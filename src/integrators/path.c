@@ -44,7 +44,8 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
         return f;
     cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
     (*rays)++;
-    if (cdl_occluded(s, o, ls.wi, ls.dist < FLT_MAX ? ls.dist * (1.0f - 1e-4f) : FLT_MAX))
+    uint32_t skip = l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
+    if (cdl_occluded_skip(s, o, ls.wi, ls.dist < FLT_MAX ? ls.dist * (1.0f - 1e-4f) : FLT_MAX, skip))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float pdf_l = ls.pdf * pmf;
     float cos = fabsf(cdl_dot(ls.wi, b->frame.n));

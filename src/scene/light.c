@@ -15,6 +15,13 @@ static float spot_falloff(const cdl_light *l, float cos_t)
     return (d * d) * (d * d);
 }
 
+/* 1 - cos(theta_max) of the cone a sphere subtends, sin^2 theta_max given:
+ * s / (1 + sqrt(1 - s)) keeps full precision where 1 - sqrt(1 - s) would not. */
+static float one_minus_cos_max(float sin2)
+{
+    return sin2 / (1.0f + sqrtf(cdl_maxf(0.0f, 1.0f - sin2)));
+}
+
 static int sample_sphere(const cdl_light *l, cdl_vec3 ref, float u1, float u2, cdl_light_sample *s)
 {
     cdl_vec3 dc = cdl_sub(l->p, ref);
@@ -41,9 +48,12 @@ static int sample_sphere(const cdl_light *l, cdl_vec3 ref, float u1, float u2, c
     float dist_c = sqrtf(d2);
     cdl_vec3 wc = cdl_scale(dc, 1.0f / dist_c);
     float sin2_max = r2 / d2;
-    float cos_max = sqrtf(cdl_maxf(0.0f, 1.0f - sin2_max));
-    float cos_t = (1.0f - u1) + u1 * cos_max;
-    float sin_t2 = cdl_maxf(0.0f, 1.0f - cos_t * cos_t);
+    float omc = one_minus_cos_max(sin2_max);
+    /* cos_t = 1 - u1 omc; sin^2 from omc directly, as 1 - cos^2 cancels
+     * catastrophically for small, distant spheres */
+    float x = u1 * omc;
+    float cos_t = 1.0f - x;
+    float sin_t2 = x * (2.0f - x);
     float phi = 2.0f * CDL_PI * u2;
     float ds = dist_c * cos_t - sqrtf(cdl_maxf(0.0f, r2 - d2 * sin_t2));
     float cos_a = (d2 + r2 - ds * ds) / (2.0f * dist_c * l->radius);
@@ -56,7 +66,7 @@ static int sample_sphere(const cdl_light *l, cdl_vec3 ref, float u1, float u2, c
     if (!(s->dist > 0.0f))
         return 0;
     s->wi = cdl_scale(d, 1.0f / s->dist);
-    s->pdf = 1.0f / (2.0f * CDL_PI * (1.0f - cos_max));
+    s->pdf = 1.0f / (2.0f * CDL_PI * omc);
     s->Li = cdl_light_Le(l, n, cdl_neg(s->wi));
     s->delta = 0;
     return !cdl_is_black(s->Li) && isfinite(s->pdf);
@@ -139,8 +149,7 @@ float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist
             float c = fabsf(cdl_dot(n, wi));
             return c > 0.0f ? dist * dist / (c * l->area) : 0.0f;
         }
-        float cos_max = sqrtf(cdl_maxf(0.0f, 1.0f - r2 / d2));
-        return 1.0f / (2.0f * CDL_PI * (1.0f - cos_max));
+        return 1.0f / (2.0f * CDL_PI * one_minus_cos_max(r2 / d2));
     }
     case CDL_LIGHT_INFINITE:
         return 0.25f * CDL_INV_PI;

@@ -368,6 +368,17 @@ static int build_lights(cdl_scene *s, cdl_error *err)
     return 0;
 }
 
+/* Occlusion filter of the sphere geometry: drops hits on the sphere the
+ * shadow ray is aimed at (cdl_shadow_ctx). */
+static void skip_target_sphere(const struct RTCFilterFunctionNArguments *args)
+{
+    const cdl_shadow_ctx *sc = (const cdl_shadow_ctx *)args->context;
+    for (unsigned i = 0; i < args->N; i++)
+        /* RTCHitN is SoA: Ng x y z, u, v, then primID (rtcore_ray.h) */
+        if (args->valid[i] && ((const unsigned *)args->hit)[5 * args->N + i] == sc->skip_sphere)
+            args->valid[i] = 0;
+}
+
 int cdl_scene_commit(cdl_scene *s, cdl_error *err)
 {
     if (s->ntris == 0 && s->nspheres == 0)
@@ -414,6 +425,7 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
             return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "Embree could not create spheres");
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, s->sph, 0,
                                    4 * sizeof(float), s->nspheres);
+        rtcSetGeometryOccludedFilterFunction(g, skip_target_sphere);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(s->rtc, g, CDL_GEOM_SPHERES);
         rtcReleaseGeometry(g);
@@ -430,9 +442,10 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
 {
     enum { CHUNK = 64 };
     struct RTCRay rays[CHUNK];
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    cdl_shadow_ctx sc;
+    rtcInitIntersectContext(&sc.ctx);
+    sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sc.skip_sphere = UINT32_MAX;
     for (uint32_t base = 0; base < n; base += CHUNK) {
         uint32_t m = n - base < CHUNK ? n - base : CHUNK;
         for (uint32_t i = 0; i < m; i++) {
@@ -449,7 +462,7 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
             r->flags = 0;
             r->time = 0.0f;
         }
-        rtcOccluded1M(s->rtc, &ctx, rays, m, sizeof(struct RTCRay));
+        rtcOccluded1M(s->rtc, &sc.ctx, rays, m, sizeof(struct RTCRay));
         for (uint32_t i = 0; i < m; i++)
             blocked[base + i] = rays[i].tfar < 0.0f;
     }

@@ -150,10 +150,22 @@ static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, floa
     return 1;
 }
 
-/* 1 if anything blocks o + t d for t in (0, tmax). */
-static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float tmax)
+/* Occlusion queries carry this extended context: a shadow ray aimed at a
+ * point on an analytic sphere ignores that sphere, whose grazing
+ * intersections are too ill-conditioned to end the ray just short of it. */
+typedef struct cdl_shadow_ctx {
+    struct RTCIntersectContext ctx;
+    uint32_t skip_sphere; /* sphere index or UINT32_MAX */
+} cdl_shadow_ctx;
+
+/* 1 if anything other than sphere skip_sphere blocks o + t d, t in (0, tmax). */
+static inline int cdl_occluded_skip(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float tmax,
+                                    uint32_t skip_sphere)
 {
-    struct RTCIntersectContext ctx = cdl_context();
+    cdl_shadow_ctx sc;
+    rtcInitIntersectContext(&sc.ctx);
+    sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    sc.skip_sphere = skip_sphere;
     struct RTCRay r;
     r.org_x = o.x;
     r.org_y = o.y;
@@ -166,8 +178,13 @@ static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float
     r.mask = 0xFFFFFFFFu;
     r.flags = 0;
     r.time = 0.0f;
-    rtcOccluded1(s->rtc, &ctx, &r);
+    rtcOccluded1(s->rtc, &sc.ctx, &r);
     return r.tfar < 0.0f;
+}
+
+static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float tmax)
+{
+    return cdl_occluded_skip(s, o, d, tmax, UINT32_MAX);
 }
 
 /* A bundle of shadow rays traced together as an Embree ray stream

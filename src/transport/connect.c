@@ -26,7 +26,8 @@ float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
     }
 }
 
-int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb)
+int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb,
+                uint32_t skip_sphere)
 {
     cdl_vec3 d = cdl_sub(pb, pa);
     cdl_vec3 o = cdl_is_black(na) ? pa : cdl_offset(s, pa, na, d);
@@ -35,7 +36,16 @@ int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_v
     float len = cdl_length(de);
     if (!(len > 0.0f))
         return 1;
-    return !cdl_occluded(s, o, cdl_scale(de, 1.0f / len), len);
+    return !cdl_occluded_skip(s, o, cdl_scale(de, 1.0f / len), len, skip_sphere);
+}
+
+/* The sphere a light vertex y_0 lies on, for cdl_visible. */
+static uint32_t light_sphere(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i)
+{
+    if (!(vs->flags[i] & CDL_V_LIGHT))
+        return UINT32_MAX;
+    const cdl_light *l = &cx->scene->lights[vs->light[i]];
+    return l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
 }
 
 /* Normal used for area-density conversions and cosines: none for the
@@ -101,6 +111,23 @@ static cdl_vec3 vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, 
     return cdl_scale(f, den > 0.0f ? num / den : 0.0f);
 }
 
+/* Area density of next-event estimation choosing light point y (normal n)
+ * of light `li` from z: only spheres (sampled by solid angle) differ from
+ * the light paths' uniform area density. */
+static float resample_pdf(const cdl_connect_ctx *cx, int32_t li, cdl_vec3 y, cdl_vec3 n, cdl_vec3 z)
+{
+    const cdl_light *l = &cx->scene->lights[li];
+    if (!cx->resample_s1 || l->type != CDL_LIGHT_SPHERE)
+        return 0.0f;
+    cdl_vec3 d = cdl_sub(y, z);
+    float dist = cdl_length(d);
+    if (!(dist > 0.0f))
+        return 0.0f;
+    cdl_vec3 w = cdl_scale(d, 1.0f / dist);
+    float sa = cdl_light_pdf_li(l, z, w, dist);
+    return cx->scene->light_select.pmf[li] * sa * fabsf(cdl_dot(n, w)) / (dist * dist);
+}
+
 /* MIS records of the full path: eye vertices 0..t-1, then light vertices
  * s-1..0 (indices l0 + j). */
 static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_t t,
@@ -111,6 +138,7 @@ static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_
         v[k].pdf_light = evs->pdf_rev[k];
         v[k].delta = (evs->flags[k] & CDL_V_DELTA) != 0;
         v[k].g_next = 0.0f;
+        v[k].pdf_s1 = 0.0f;
         if (need_g && k + 1 < t)
             v[k].g_next = cdl_geometry(evs->p[k], vnormal(evs, k), evs->p[k + 1], vnormal(evs, k + 1));
     }
@@ -120,6 +148,7 @@ static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_
         v[k].pdf_light = lvs->pdf_fwd[i];
         v[k].delta = (lvs->flags[i] & CDL_V_DELTA) != 0;
         v[k].g_next = 0.0f;
+        v[k].pdf_s1 = 0.0f;
     }
 }
 
@@ -141,6 +170,7 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
         return zero;
     fill_records(v, evs, t, NULL, 0, 0, cx->mis == CDL_MIS_STRATIFIED);
     v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
+    v[i].pdf_s1 = resample_pdf(cx, evs->light[i], evs->p[i], evs->ng[i], evs->p[i - 1]);
     v[i - 1].pdf_light = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[i], evs->wi[i]), evs->p[i],
                                          evs->p[i - 1], vnormal(evs, i - 1));
     v[i].delta = 0;
@@ -180,12 +210,14 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     if (s >= 2)
         v[t + 1].pdf_eye = vertex_pdf(cx, lvs, qs, pp, qm, vnormal(lvs, qs - 1));
     v[pt].delta = v[t].delta = 0;
+    v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
+                                       s >= 2 ? lvs->p[l0 + 1] : pp);
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
     float w = cdl_mis_weight(cx->mis, v, (int)s, (int)t, delta_light, cx->counts, cx->threshold);
     if (w <= 0.0f)
         return zero;
     (*rays)++;
-    if (!cdl_visible(cx->scene, pp, np, qp, nq))
+    if (!cdl_visible(cx->scene, pp, np, qp, nq, light_sphere(cx, lvs, qs)))
         return zero;
     return cdl_scale(c, w);
 }
@@ -223,6 +255,8 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     v[0].pdf_light = 0.0f;
     v[0].delta = 0;
     v[0].g_next = 0.0f;
+    v[0].pdf_s1 = 0.0f;
+    v[s].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
     cdl_vec3 nq = vnormal(lvs, qs);
     v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
     v[2].pdf_eye = vertex_pdf(cx, lvs, qs, cam->eye, qm, vnormal(lvs, qs - 1));
@@ -232,7 +266,7 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     if (wgt <= 0.0f)
         return zero;
     (*rays)++;
-    if (!cdl_visible(cx->scene, cam->eye, cdl_v3(0.0f, 0.0f, 0.0f), qp, nq))
+    if (!cdl_visible(cx->scene, cam->eye, cdl_v3(0.0f, 0.0f, 0.0f), qp, nq, UINT32_MAX))
         return zero;
     return cdl_scale(c, wgt);
 }

@@ -14,6 +14,7 @@ typedef struct cdl_connect_ctx {
     cdl_mis_kind mis;
     float threshold;            /* stratification heuristic's t */
     const cdl_mis_counts *counts;
+    int resample_s1;            /* s = 1 samples the light point as next-event estimation does */
 } cdl_connect_ctx;
 
 /* s = 0: the eye path's vertex t-1 lies on a light; Le there, weighted. */
@@ -44,8 +45,10 @@ static inline float cdl_geometry(cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3
 }
 
 /* 1 if nothing blocks the segment between two vertices (offset off their
- * surfaces; a zero normal marks a point that needs no offset). */
-int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb);
+ * surfaces; a zero normal marks a point that needs no offset). skip_sphere:
+ * the sphere light pb lies on, or UINT32_MAX. */
+int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb,
+                uint32_t skip_sphere);
 
 /* The fraction of a light's emission y_0 sends towards unit w: 1 or 0
  * for diffuse area lights, the falloff for spots, 1 for points. */

@@ -45,12 +45,17 @@ float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, i
     if (s + t == 2)
         return 1.0f;
     int pw = kind == CDL_MIS_POWER;
-    float here = count(n, s, t), sum = 0.0f, r = 1.0f;
+    /* s = 1 may sample the light point differently from the light paths:
+     * its density enters that one strategy only */
+    int L = s + t - 1;
+    float q = v[L].pdf_s1 > 0.0f && v[L].pdf_light > 0.0f ? v[L].pdf_s1 / v[L].pdf_light : 1.0f;
+    float here = count(n, s, t) * (s == 1 ? q : 1.0f), sum = 0.0f, r = 1.0f;
+#define CORR(sp, tp) hpow(count(n, sp, tp) * ((sp) == 1 ? q : 1.0f) / here, pw)
     /* moving the connection towards the camera: fewer eye vertices */
     for (int i = t - 1; i > 0; i--) {
         r *= hpow(remap0(v[i].pdf_light) / remap0(v[i].pdf_eye), pw);
         if (!v[i].delta && !v[i - 1].delta)
-            sum += r * hpow(count(n, s + t - i, i) / here, pw);
+            sum += r * CORR(s + t - i, i);
     }
     /* towards the light: fewer light vertices */
     r = 1.0f;
@@ -58,7 +63,8 @@ float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, i
         r *= hpow(remap0(v[i].pdf_eye) / remap0(v[i].pdf_light), pw);
         int delta_prev = i + 1 < s + t ? v[i + 1].delta : delta_light;
         if (!v[i].delta && !delta_prev)
-            sum += r * hpow(count(n, s + t - i - 1, i + 1) / here, pw);
+            sum += r * CORR(s + t - i - 1, i + 1);
     }
+#undef CORR
     return 1.0f / (1.0f + sum);
 }

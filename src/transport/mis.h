@@ -16,6 +16,8 @@ typedef struct cdl_mis_vertex {
     float pdf_light; /* area density sampled from the light side (from z_{k+1}; z_L: light origin) */
     int delta;       /* cannot be connected to */
     float g_next;    /* stratification: G(z_k, z_{k+1}) */
+    float pdf_s1;    /* z_L only: its area density when s = 1 samples it anew from
+                        z_{L-1} (next-event style); 0: the same as pdf_light */
 } cdl_mis_vertex;
 
 /* Samples each strategy takes per eye sample: pure eye paths (s = 0),
