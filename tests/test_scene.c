@@ -58,7 +58,7 @@ int main(int argc, char **argv)
         t[i] = cdl_length(e);
         d[i] = cdl_scale(e, 1.0f / t[i]);
     }
-    cdl_occluded_bundle(&s, N, o, d, t, blocked);
+    cdl_occluded_bundle(&s, N, o, d, t, UINT32_MAX, blocked);
     for (int i = 0; i < N; i++) {
         agree += blocked[i] == cdl_occluded(&s, o[i], d[i], t[i]);
         nblocked += blocked[i];

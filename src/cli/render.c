@@ -39,7 +39,7 @@ typedef struct render_args {
     cdl_mis_kind mis;
     long light_paths, interleave;
     double threshold, clamp;
-    int strata_distance;
+    int strata_distance, single_shadow_rays;
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;
@@ -76,6 +76,8 @@ static void render_help(void)
            "      --interleave N      N x N interleaved sets of the K paths (default 1)\n"
            "      --clamp c           ir: clamp G at c (default: 1 / (0.05 d)^2)\n"
            "      --strata KIND       rigi: geometry (threshold G, default) or distance\n"
+           "      --shadow-rays KIND  rigi/ir: bundle (one Embree stream per point light and\n"
+           "                          tile, default) or single\n"
            "  -q, --quiet             no warnings, no progress bar\n"
            "\n"
            "Integrators:\n");
@@ -139,7 +141,7 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                                        "--res", "--lookat", "--fov", "--maxdepth", "--seed",
                                        "--threads", "--point-light", "--exposure", "--sampler",
                                        "--mis", "--light-paths", "--interleave", "--threshold",
-                                       "--clamp", "--strata"};
+                                       "--clamp", "--strata", "--shadow-rays"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(o, valued[k]);
@@ -220,6 +222,13 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->strata_distance = 1;
             else
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected geometry or distance, got '%s'", v);
+        } else if (!strcmp(o, "--shadow-rays")) {
+            if (!strcmp(v, "bundle"))
+                a->single_shadow_rays = 0;
+            else if (!strcmp(v, "single"))
+                a->single_shadow_rays = 1;
+            else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected bundle or single, got '%s'", v);
         } else if (!strcmp(o, "--exposure")) {
             rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
             a->exposure = d;
@@ -334,6 +343,7 @@ int cdl_cmd_render(int argc, char **argv)
     opt.threshold = (float)a.threshold;
     opt.clamp = (float)a.clamp;
     opt.strata_distance = a.strata_distance;
+    opt.single_shadow_rays = a.single_shadow_rays;
     if (!rc && a.has_lookat)
         rc = cdl_camera_init(&opt.camera, cdl_v3(a.lookat[0], a.lookat[1], a.lookat[2]),
                              cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),

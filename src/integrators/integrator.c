@@ -7,8 +7,11 @@ volatile sig_atomic_t cdl_cancel = 0;
 
 extern const cdl_integrator_vtbl cdl_path_integrator;
 extern const cdl_integrator_vtbl cdl_bdpt_integrator;
+extern const cdl_integrator_vtbl cdl_ir_integrator;
+extern const cdl_integrator_vtbl cdl_rigi_integrator;
 
-static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator, NULL};
+static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
+                                                 &cdl_ir_integrator, &cdl_rigi_integrator, NULL};
 
 void cdl_options_default(cdl_options *o)
 {

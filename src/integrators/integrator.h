@@ -28,6 +28,7 @@ typedef struct cdl_options {
     float threshold;       /* stratification threshold t on G; <= 0: derived from the scene */
     float clamp;           /* ir: clamp G at this value; <= 0: derived from the scene */
     int strata_distance;   /* rigi: threshold the distance instead of G (Figure 2c) */
+    int single_shadow_rays; /* rigi/ir: trace shadow rays one by one instead of as bundles */
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the

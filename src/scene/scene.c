@@ -438,14 +438,15 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
 }
 
 void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
-                         const cdl_vec3 *d, const float *tmax, uint8_t *blocked)
+                         const cdl_vec3 *d, const float *tmax, uint32_t skip_sphere,
+                         uint8_t *blocked)
 {
     enum { CHUNK = 64 };
     struct RTCRay rays[CHUNK];
     cdl_shadow_ctx sc;
     rtcInitIntersectContext(&sc.ctx);
     sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    sc.skip_sphere = UINT32_MAX;
+    sc.skip_sphere = skip_sphere;
     for (uint32_t base = 0; base < n; base += CHUNK) {
         uint32_t m = n - base < CHUNK ? n - base : CHUNK;
         for (uint32_t i = 0; i < m; i++) {

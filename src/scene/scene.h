@@ -191,7 +191,8 @@ static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float
  * (coherent when they share an end point, as the point-light methods'
  * bundles do). Sets hit[i] = 1 where ray i is blocked. */
 void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
-                         const cdl_vec3 *d, const float *tmax, uint8_t *blocked);
+                         const cdl_vec3 *d, const float *tmax, uint32_t skip_sphere,
+                         uint8_t *blocked);
 
 void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
 /* Texture lookup folded in. */

@@ -50,7 +50,7 @@ static uint32_t light_sphere(const cdl_connect_ctx *cx, const cdl_vertex_store *
 
 /* Normal used for area-density conversions and cosines: none for the
  * camera and for point and spot lights. */
-static cdl_vec3 vnormal(const cdl_vertex_store *vs, uint32_t i)
+cdl_vec3 cdl_vertex_normal(const cdl_vertex_store *vs, uint32_t i)
 {
     if (vs->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
         return cdl_v3(0.0f, 0.0f, 0.0f);
@@ -91,8 +91,8 @@ static float vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, u
 /* f at vertex i for light arriving from `from` and leaving to `to` (eye
  * vertices: radiance mode; light vertices: importance mode with Veach's
  * shading-normal correction; y_0: the emission distribution). */
-static cdl_vec3 vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
-                         cdl_vec3 from, cdl_vec3 to, int light_side)
+cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                      cdl_vec3 from, cdl_vec3 to, int light_side)
 {
     cdl_vec3 p = vs->p[i];
     cdl_vec3 wt = cdl_normalize(cdl_sub(to, p));
@@ -140,7 +140,7 @@ static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_
         v[k].g_next = 0.0f;
         v[k].pdf_s1 = 0.0f;
         if (need_g && k + 1 < t)
-            v[k].g_next = cdl_geometry(evs->p[k], vnormal(evs, k), evs->p[k + 1], vnormal(evs, k + 1));
+            v[k].g_next = cdl_geometry(evs->p[k], cdl_vertex_normal(evs, k), evs->p[k + 1], cdl_vertex_normal(evs, k + 1));
     }
     for (uint32_t j = 0; j < s; j++) {
         uint32_t k = s + t - 1 - j, i = l0 + j;
@@ -172,7 +172,7 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
     v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
     v[i].pdf_s1 = resample_pdf(cx, evs->light[i], evs->p[i], evs->ng[i], evs->p[i - 1]);
     v[i - 1].pdf_light = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[i], evs->wi[i]), evs->p[i],
-                                         evs->p[i - 1], vnormal(evs, i - 1));
+                                         evs->p[i - 1], cdl_vertex_normal(evs, i - 1));
     v[i].delta = 0;
     return cdl_scale(c, cdl_mis_weight(cx->mis, v, 0, (int)t, 0, cx->counts, cx->threshold));
 }
@@ -187,10 +187,10 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     cdl_vec3 pp = evs->p[pt], qp = lvs->p[qs];
     cdl_vec3 pm = evs->p[pt - 1];
     cdl_vec3 qm = s >= 2 ? lvs->p[qs - 1] : qp;
-    cdl_vec3 fe = vertex_f(cx, evs, pt, pm, qp, 0);
+    cdl_vec3 fe = cdl_vertex_f(cx, evs, pt, pm, qp, 0);
     if (cdl_is_black(fe))
         return zero;
-    cdl_vec3 fl = vertex_f(cx, lvs, qs, qm, pp, 1);
+    cdl_vec3 fl = cdl_vertex_f(cx, lvs, qs, qm, pp, 1);
     if (cdl_is_black(fl))
         return zero;
     float G = cdl_geometry(pp, vshading(evs, pt), qp, vshading(lvs, qs));
@@ -201,14 +201,14 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     cdl_mis_vertex v[MAX_PATH];
     int strat = cx->mis == CDL_MIS_STRATIFIED;
     fill_records(v, evs, t, lvs, l0, s, strat);
-    cdl_vec3 np = vnormal(evs, pt), nq = vnormal(lvs, qs);
+    cdl_vec3 np = cdl_vertex_normal(evs, pt), nq = cdl_vertex_normal(lvs, qs);
     v[pt].g_next = cdl_geometry(pp, np, qp, nq);
     /* densities through the new edge, both ways (pbrt-v3's MISWeight) */
     v[pt].pdf_light = vertex_pdf(cx, lvs, qs, qm, pp, np);
-    v[pt - 1].pdf_light = vertex_pdf(cx, evs, pt, qp, pm, vnormal(evs, pt - 1));
+    v[pt - 1].pdf_light = vertex_pdf(cx, evs, pt, qp, pm, cdl_vertex_normal(evs, pt - 1));
     v[t].pdf_eye = vertex_pdf(cx, evs, pt, pm, qp, nq);
     if (s >= 2)
-        v[t + 1].pdf_eye = vertex_pdf(cx, lvs, qs, pp, qm, vnormal(lvs, qs - 1));
+        v[t + 1].pdf_eye = vertex_pdf(cx, lvs, qs, pp, qm, cdl_vertex_normal(lvs, qs - 1));
     v[pt].delta = v[t].delta = 0;
     v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
                                        s >= 2 ? lvs->p[l0 + 1] : pp);
@@ -241,7 +241,7 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     float pdf_cam;
     float We = cdl_camera_We(cam, w, &pdf_cam);
     float cos_cam = cdl_dot(w, cam->fwd) / cdl_length(cam->fwd);
-    cdl_vec3 fl = vertex_f(cx, lvs, qs, qm, cam->eye, 1);
+    cdl_vec3 fl = cdl_vertex_f(cx, lvs, qs, qm, cam->eye, 1);
     float cos_q = fabsf(cdl_dot(w, lvs->ns[qs]));
     cdl_vec3 c = cdl_scale(cdl_mul(lvs->beta[qs], fl), We * cos_cam / d2 * cos_q);
     if (cdl_is_black(c))
@@ -257,9 +257,9 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     v[0].g_next = 0.0f;
     v[0].pdf_s1 = 0.0f;
     v[s].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
-    cdl_vec3 nq = vnormal(lvs, qs);
+    cdl_vec3 nq = cdl_vertex_normal(lvs, qs);
     v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
-    v[2].pdf_eye = vertex_pdf(cx, lvs, qs, cam->eye, qm, vnormal(lvs, qs - 1));
+    v[2].pdf_eye = vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
     v[1].delta = 0;
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
     float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, cx->counts, cx->threshold);

@@ -30,6 +30,17 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
 cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0,
                             uint32_t s, float *x, float *y, uint64_t *rays);
 
+/* Normal of vertex i for cosines and densities: zero for the camera and
+ * for point and spot lights. */
+cdl_vec3 cdl_vertex_normal(const cdl_vertex_store *vs, uint32_t i);
+
+/* f at vertex i for light arriving from position `from` and leaving to
+ * `to`: eye vertices in radiance mode, light vertices (light_side) in
+ * importance mode with Veach's shading-normal correction, y_0 the light's
+ * emission distribution. */
+cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                      cdl_vec3 from, cdl_vec3 to, int light_side);
+
 /* G = |cos a| |cos b| / d^2 with geometric... shading normals na, nb
  * (zero normal: a point, cosine 1). */
 static inline float cdl_geometry(cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb)
