@@ -6,14 +6,11 @@
 #define CDL_OBJ_CHECK_H
 
 #include "core/error.h"
+#include "core/file.h"
 
 int cdl_obj_check(const char *path, cdl_error *err);
 
-/* Shared by the loaders: reads a whole regular file (NUL-terminated),
- * rejecting directories, unreadable and oversized files. */
+/* A whole text file (scene descriptions: at most 2 GiB), see cdl_read_file. */
 int cdl_read_text_file(const char *path, char **data, size_t *size, cdl_error *err);
-
-/* Directory part of path joined with name (name kept if absolute). */
-void cdl_path_join_dir(const char *path, const char *name, char *out, size_t n);
 
 #endif

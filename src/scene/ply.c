@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "scene/ply.h"
 
+#include "core/file.h"
+
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
@@ -72,40 +74,6 @@ void cdl_ply_free(cdl_ply_mesh *m)
 }
 
 /* ---- file ---------------------------------------------------------------------------------- */
-
-static int read_file(const char *path, unsigned char **data, size_t *size, cdl_error *err)
-{
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "cannot open: %s", strerror(errno));
-    if (S_ISDIR(st.st_mode))
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "is a directory, not a file");
-    if (!S_ISREG(st.st_mode))
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "not a regular file");
-    if ((uint64_t)st.st_size > PLY_MAX_BYTES || (uint64_t)st.st_size >= SIZE_MAX)
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "file too large (%" PRIu64 " bytes)",
-                             (uint64_t)st.st_size);
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "cannot open: %s", strerror(errno));
-    size_t n = (size_t)st.st_size;
-    unsigned char *buf = malloc(n + 1);
-    if (!buf) {
-        fclose(f);
-        return cdl_error_set(err, CDL_ERR_SYSTEM, path, 0, "out of memory reading %zu bytes", n);
-    }
-    size_t got = fread(buf, 1, n, f);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad || got != n) {
-        free(buf);
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "read error");
-    }
-    buf[n] = 0; /* the header tokenizer relies on a terminator */
-    *data = buf;
-    *size = n;
-    return 0;
-}
 
 /* ---- messages ------------------------------------------------------------------------------ */
 
@@ -851,7 +819,7 @@ int cdl_ply_read(const char *path, cdl_ply_mesh *m, cdl_error *err)
     memset(m, 0, sizeof *m);
     unsigned char *data = NULL;
     size_t size = 0;
-    int rc = read_file(path, &data, &size, err);
+    int rc = cdl_read_file(path, PLY_MAX_BYTES, (char **)&data, &size, err);
     if (rc)
         return rc;
     /* The element table is large; keep it off the stack. */

@@ -1,0 +1,791 @@
+#!/usr/bin/python3
+"""Procedural test scenes for candela (Wavefront OBJ + MTL).
+
+    scenes/generate.py OUTDIR [NAME ...]
+
+writes NAME.obj, NAME.mtl and NAME.cam for every named scene (default: all) into
+OUTDIR. NAME.cam is one line of `--lookat ... --fov ...` arguments for a good
+default view, so that a script can run
+
+    candela render OUTDIR/NAME.obj $(cat OUTDIR/NAME.cam) ...
+
+Conventions: metres, y up. Every wall, floor and ceiling is a closed box (a solid
+slab) made of quads of two triangles each, wound counter-clockwise seen from outside
+the slab, so that the faces bounding a room face into it (the floor's top face has
+normal +y). Walls reach 0.1 m into the floor and ceiling slabs and half a wall
+thickness into the walls they meet, so no crack lets light through; every building
+is enclosed by its outer walls, floor and ceiling. Light panels are single quads just
+below the ceiling whose front (emitting) face points down. The output is
+deterministic: no randomness except random.Random with fixed seeds.
+"""
+
+import math
+import os
+import random
+import sys
+
+H_DOOR = 2.1  # door opening height (m)
+
+
+def _fmt(x):
+    s = "%.4f" % x
+    s = s.rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _norm(a):
+    n = math.sqrt(_dot(a, a))
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+class Scene:
+    def __init__(self, name):
+        self.name = name
+        self.verts = []
+        self.vindex = {}
+        self.normals = []
+        self.nindex = {}
+        self.groups = []  # [name, [(mtl, ((v, n), (v, n), (v, n)))...]]
+        self.mtls = {}  # name -> list of MTL lines
+        self.light_panels = 0
+        self.light_area = 0.0
+        self.camera = None
+        self.note = ""
+
+    # --- materials ------------------------------------------------------------
+    def material(self, name, kd=(0.5, 0.5, 0.5), ks=None, ns=None, ke=None, illum=None,
+                 ni=None):
+        if name in self.mtls:
+            return name
+        lines = ["Kd %s %s %s" % tuple(_fmt(c) for c in kd)]
+        if ks is not None:
+            lines.append("Ks %s %s %s" % tuple(_fmt(c) for c in ks))
+        if ns is not None:
+            lines.append("Ns %s" % _fmt(ns))
+        if ni is not None:
+            lines.append("Ni %s" % _fmt(ni))
+        if ke is not None:
+            lines.append("Ke %s %s %s" % tuple(_fmt(c) for c in ke))
+        if illum is not None:
+            lines.append("illum %d" % illum)
+        self.mtls[name] = lines
+        return name
+
+    # --- geometry -------------------------------------------------------------
+    def group(self, name):
+        self.groups.append([name, []])
+
+    def _v(self, p):
+        key = tuple(_fmt(c) for c in p)
+        i = self.vindex.get(key)
+        if i is None:
+            self.verts.append(key)
+            i = self.vindex[key] = len(self.verts)
+        return i
+
+    def _n(self, n):
+        key = tuple(_fmt(c) for c in n)
+        i = self.nindex.get(key)
+        if i is None:
+            self.normals.append(key)
+            i = self.nindex[key] = len(self.normals)
+        return i
+
+    def tri(self, a, b, c, mtl, na=None, nb=None, nc=None):
+        if not self.groups:
+            self.group("default")
+        if na is None:
+            f = ((self._v(a), None), (self._v(b), None), (self._v(c), None))
+        else:
+            f = ((self._v(a), self._n(na)), (self._v(b), self._n(nb)), (self._v(c), self._n(nc)))
+        self.groups[-1][1].append((mtl, f))
+
+    def quad(self, p, normal, mtl):
+        """A planar quad p[0..3] (in order around its edge) as two triangles wound
+        counter-clockwise seen from the side `normal` points to."""
+        n = _cross(_sub(p[1], p[0]), _sub(p[2], p[0]))
+        if _dot(n, normal) < 0:
+            p = p[::-1]
+        assert _dot(_cross(_sub(p[1], p[0]), _sub(p[2], p[0])), normal) > 0
+        self.tri(p[0], p[1], p[2], mtl)
+        self.tri(p[0], p[2], p[3], mtl)
+
+    def box(self, lo, hi, mtl, face_mtl=None, rot=None):
+        """Closed box [lo, hi], faces wound outwards. face_mtl maps any of
+        '-x' '+x' '-y' '+y' '-z' '+z' to another material. rot = (angle in degrees
+        about the y axis, pivot (x, z)) turns the box about a vertical axis."""
+        assert all(hi[i] > lo[i] for i in range(3)), (lo, hi)
+        face_mtl = face_mtl or {}
+        if rot:
+            a = math.radians(rot[0])
+            ca, sa = math.cos(a), math.sin(a)
+            px, pz = rot[1]
+
+            def tr(p):  # counter-clockwise seen from above (+y) for a > 0
+                dx, dz = p[0] - px, p[2] - pz
+                return (px + ca * dx + sa * dz, p[1], pz - sa * dx + ca * dz)
+
+            def tn(n):
+                return (ca * n[0] + sa * n[2], n[1], -sa * n[0] + ca * n[2])
+        else:
+            def tr(p):
+                return p
+
+            def tn(n):
+                return n
+        x0, y0, z0 = lo
+        x1, y1, z1 = hi
+        faces = {
+            "-x": ((x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)),
+            "+x": ((x1, y0, z0), (x1, y0, z1), (x1, y1, z1), (x1, y1, z0)),
+            "-y": ((x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)),
+            "+y": ((x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1)),
+            "-z": ((x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0)),
+            "+z": ((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)),
+        }
+        normals = {"-x": (-1, 0, 0), "+x": (1, 0, 0), "-y": (0, -1, 0), "+y": (0, 1, 0),
+                   "-z": (0, 0, -1), "+z": (0, 0, 1)}
+        for k in ("-y", "+y", "-x", "+x", "-z", "+z"):
+            self.quad([tr(p) for p in faces[k]], tn(normals[k]), face_mtl.get(k, mtl))
+
+    def light(self, cx, cz, sx, sz, y, mtl):
+        """A light panel: one quad of sx by sz metres centred at (cx, y, cz), emitting
+        downwards (front face normal -y)."""
+        x0, x1, z0, z1 = cx - sx / 2, cx + sx / 2, cz - sz / 2, cz + sz / 2
+        self.quad(((x0, y, z0), (x1, y, z0), (x1, y, z1), (x0, y, z1)), (0, -1, 0), mtl)
+        self.light_panels += 1
+        self.light_area += sx * sz
+
+    def wall(self, axis, c, a0, a1, t, mtl, doors=(), y0=-0.1, y1=3.1, face_mtl=None,
+             door_h=H_DOOR):
+        """A straight wall of thickness t centred on the line {axis-coordinate free,
+        other horizontal coordinate = c} from a0 to a1 along `axis` ('x' or 'z'),
+        extended by t/2 at both ends, from y0 to y1, with door gaps (d0, d1) along the
+        axis up to door_h (a lintel above each)."""
+        lo_a, hi_a = a0 - t / 2, a1 + t / 2
+        pieces = []
+        cur = lo_a
+        for d0, d1 in sorted(doors):
+            assert d0 > cur and d1 > d0
+            pieces.append((cur, d0, y0, y1))
+            pieces.append((d0, d1, door_h, y1))
+            cur = d1
+        pieces.append((cur, hi_a, y0, y1))
+        for p0, p1, q0, q1 in pieces:
+            if axis == "x":
+                self.box((p0, q0, c - t / 2), (p1, q1, c + t / 2), mtl, face_mtl)
+            else:
+                self.box((c - t / 2, q0, p0), (c + t / 2, q1, p1), mtl, face_mtl)
+
+    def shell(self, x0, x1, z0, z1, h, t, wall_mtl, floor_mtl, ceil_mtl, wall_face_mtl=None):
+        """Floor and ceiling slabs and the four outer walls around the interior
+        [x0, x1] x [0, h] x [z0, z1]. wall_face_mtl: side ('-x', '+x', '-z', '+z', i.e.
+        the wall at x0, x1, z0, z1) -> material of that wall's inner face."""
+        wf = wall_face_mtl or {}
+        self.group("floor")
+        self.box((x0 - t, -t, z0 - t), (x1 + t, 0, z1 + t), floor_mtl)
+        self.group("ceiling")
+        self.box((x0 - t, h, z0 - t), (x1 + t, h + t, z1 + t), ceil_mtl)
+        self.group("outer_walls")
+        y0, y1 = -t / 2, h + t / 2
+        self.box((x0 - t, y0, z0 - t), (x0, y1, z1 + t), wall_mtl,
+                 {"+x": wf["-x"]} if "-x" in wf else None)
+        self.box((x1, y0, z0 - t), (x1 + t, y1, z1 + t), wall_mtl,
+                 {"-x": wf["+x"]} if "+x" in wf else None)
+        self.box((x0 - t, y0, z0 - t), (x1 + t, y1, z0), wall_mtl,
+                 {"+z": wf["-z"]} if "-z" in wf else None)
+        self.box((x0 - t, y0, z1), (x1 + t, y1, z1 + t), wall_mtl,
+                 {"-z": wf["+z"]} if "+z" in wf else None)
+
+    def sphere(self, c, r, mtl, nu=48, nv=24):
+        """UV sphere with vertex normals, wound outwards."""
+        def pt(i, j):
+            th = math.pi * j / nv
+            ph = 2 * math.pi * i / nu
+            n = (math.sin(th) * math.cos(ph), math.cos(th), -math.sin(th) * math.sin(ph))
+            return (c[0] + r * n[0], c[1] + r * n[1], c[2] + r * n[2]), n
+        for j in range(nv):
+            for i in range(nu):
+                (a, na), (b, nb) = pt(i, j), pt(i + 1, j)
+                (cc, nc), (d, nd) = pt(i + 1, j + 1), pt(i, j + 1)
+                # outward: counter-clockwise seen from outside
+                if j != 0:
+                    self._tri_out(a, d, b, na, nd, nb, mtl, c)
+                if j != nv - 1:
+                    self._tri_out(b, d, cc, nb, nd, nc, mtl, c)
+
+    def _tri_out(self, a, b, c, na, nb, nc, mtl, centre):
+        n = _cross(_sub(b, a), _sub(c, a))
+        mid = tuple((a[k] + b[k] + c[k]) / 3 - centre[k] for k in range(3))
+        if _dot(n, mid) < 0:
+            b, c, nb, nc = c, b, nc, nb
+        self.tri(a, b, c, mtl, na, nb, nc)
+
+    def ring(self, cx, cz, r_in, r_out, h, mtl, n=96):
+        """A closed thick ring (tube wall) standing on y = 0, with vertex normals."""
+        up, down = (0, 1, 0), (0, -1, 0)
+        for i in range(n):
+            a0, a1 = 2 * math.pi * i / n, 2 * math.pi * (i + 1) / n
+            d0 = (math.cos(a0), 0, math.sin(a0))
+            d1 = (math.cos(a1), 0, math.sin(a1))
+
+            def p(d, r, y):
+                return (cx + r * d[0], y, cz + r * d[2])
+            neg0, neg1 = (-d0[0], 0, -d0[2]), (-d1[0], 0, -d1[2])
+            # outer wall, normal outwards
+            self._quad_n(p(d0, r_out, 0), p(d1, r_out, 0), p(d1, r_out, h), p(d0, r_out, h),
+                         d0, d1, d1, d0, mtl, d0)
+            # inner wall, normal towards the axis
+            self._quad_n(p(d0, r_in, 0), p(d1, r_in, 0), p(d1, r_in, h), p(d0, r_in, h),
+                         neg0, neg1, neg1, neg0, mtl, neg0)
+            # top and bottom annuli
+            self._quad_n(p(d0, r_in, h), p(d1, r_in, h), p(d1, r_out, h), p(d0, r_out, h),
+                         up, up, up, up, mtl, up)
+            self._quad_n(p(d0, r_in, 0), p(d1, r_in, 0), p(d1, r_out, 0), p(d0, r_out, 0),
+                         down, down, down, down, mtl, down)
+
+    def _quad_n(self, a, b, c, d, na, nb, nc, nd, mtl, normal):
+        n = _cross(_sub(b, a), _sub(c, a))
+        if _dot(n, normal) < 0:
+            a, b, c, d, na, nb, nc, nd = d, c, b, a, nd, nc, nb, na
+        self.tri(a, b, c, mtl, na, nb, nc)
+        self.tri(a, c, d, mtl, na, nc, nd)
+
+    # --- output ---------------------------------------------------------------
+    def triangles(self):
+        return sum(len(g[1]) for g in self.groups)
+
+    def emitting_triangles(self):
+        emitters = {k for k, v in self.mtls.items() if any(l.startswith("Ke") for l in v)}
+        return sum(1 for g in self.groups for m, _ in g[1] if m in emitters)
+
+    def write(self, outdir):
+        base = os.path.join(outdir, self.name)
+        with open(base + ".mtl", "w") as f:
+            f.write("# %s.mtl, written by scenes/generate.py\n" % self.name)
+            for k, lines in self.mtls.items():
+                f.write("\nnewmtl %s\n" % k)
+                for l in lines:
+                    f.write("  %s\n" % l)
+        with open(base + ".obj", "w") as f:
+            f.write("# %s.obj, written by scenes/generate.py (metres, y up)\n" % self.name)
+            f.write("# %d triangles, %d light panels\n" % (self.triangles(), self.light_panels))
+            f.write("mtllib %s.mtl\n" % self.name)
+            for v in self.verts:
+                f.write("v %s %s %s\n" % v)
+            for n in self.normals:
+                f.write("vn %s %s %s\n" % n)
+            for gname, faces in self.groups:
+                if not faces:
+                    continue
+                f.write("g %s\n" % gname)
+                cur = None
+                for mtl, face in faces:
+                    if mtl != cur:
+                        f.write("usemtl %s\n" % mtl)
+                        cur = mtl
+                    if face[0][1] is None:
+                        f.write("f %d %d %d\n" % (face[0][0], face[1][0], face[2][0]))
+                    else:
+                        f.write("f %d//%d %d//%d %d//%d\n" % (
+                            face[0][0], face[0][1], face[1][0], face[1][1],
+                            face[2][0], face[2][1]))
+        eye, target, fov = self.camera
+        with open(base + ".cam", "w") as f:
+            f.write("--lookat %s,%s,%s,%s,%s,%s,0,1,0 --fov %s\n" % (
+                tuple(_fmt(c) for c in eye) + tuple(_fmt(c) for c in target) + (_fmt(fov),)))
+
+
+# --- furniture ------------------------------------------------------------------
+
+def desk(s, x0, z0, w, d, mtl_top, mtl_leg, h=0.75, top=0.03, leg=0.05):
+    s.box((x0, h - top, z0), (x0 + w, h, z0 + d), mtl_top)
+    for lx in (x0 + 0.03, x0 + w - 0.03 - leg):
+        for lz in (z0 + 0.03, z0 + d - 0.03 - leg):
+            s.box((lx, 0, lz), (lx + leg, h - top, lz + leg), mtl_leg)
+
+
+def chair(s, cx, cz, mtl_seat, mtl_leg, facing=0.0, w=0.46, seat_h=0.46, back_h=0.9):
+    """A chair centred at (cx, cz); facing (degrees, counter-clockwise seen from
+    above) = 0 faces -z (the back rest is on the +z side)."""
+    rot = (facing, (cx, cz))
+    hw = w / 2
+    s.box((cx - hw, seat_h - 0.05, cz - hw), (cx + hw, seat_h, cz + hw), mtl_seat, rot=rot)
+    s.box((cx - hw, seat_h, cz + hw - 0.05), (cx + hw, back_h, cz + hw), mtl_seat, rot=rot)
+    for lx in (cx - hw + 0.02, cx + hw - 0.05):
+        for lz in (cz - hw + 0.02, cz + hw - 0.05):
+            s.box((lx, 0, lz), (lx + 0.03, seat_h - 0.05, lz + 0.03), mtl_leg, rot=rot)
+
+
+def shelf(s, x0, z0, w, d, h, mtl, book_mtls, boards=5, seed=0, along="x", flip=False):
+    """A bookshelf with books standing on the floor: w wide along `along`, d deep.
+    along == 'x': [x0, x0 + w] x [z0, z0 + d], back at z0, open towards +z;
+    along == 'z': [x0, x0 + d] x [z0, z0 + w], back at x0, open towards +x.
+    flip puts the back on the other side (open towards -z or -x)."""
+    rng = random.Random(seed)
+    th = 0.02
+
+    def B(a0, b0, y0, a1, b1, y1, m):
+        if flip:
+            b0, b1 = d - b1, d - b0
+        if along == "x":
+            s.box((x0 + a0, y0, z0 + b0), (x0 + a1, y1, z0 + b1), m)
+        else:
+            s.box((x0 + b0, y0, z0 + a0), (x0 + b1, y1, z0 + a1), m)
+    B(0, 0, 0, th, d, h, mtl)
+    B(w - th, 0, 0, w, d, h, mtl)
+    B(th, 0, 0, w - th, th, h, mtl)  # back
+    step = (h - th) / boards
+    for k in range(boards + 1):
+        y = k * step
+        B(th, th, y, w - th, d, y + th, mtl)
+        if k == boards:
+            break
+        # books on this board
+        a = th + 0.02
+        while True:
+            bw = rng.uniform(0.025, 0.06)
+            if a + bw > w - th - 0.02:
+                break
+            if rng.random() < 0.12:
+                a += rng.uniform(0.05, 0.15)
+                continue
+            bh = rng.uniform(0.6, 0.85) * (step - th)
+            bd = rng.uniform(0.6, 0.9) * (d - th)
+            B(a, th + 0.01, y + th, a + bw, th + 0.01 + bd, y + th + bh,
+              book_mtls[rng.randrange(len(book_mtls))])
+            a += bw + 0.003
+
+
+# --- scenes ---------------------------------------------------------------------
+
+def office():
+    s = Scene("office")
+    W, D, H, T = 6.0, 4.0, 3.0, 0.2
+    white = s.material("wall_white", kd=(0.72, 0.71, 0.68))
+    blue = s.material("wall_blue", kd=(0.22, 0.33, 0.55))
+    terra = s.material("wall_terracotta", kd=(0.66, 0.33, 0.22))
+    floor = s.material("carpet", kd=(0.30, 0.30, 0.33))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood", kd=(0.50, 0.34, 0.20), ks=(0.04, 0.04, 0.04), ns=60)
+    metal = s.material("metal", kd=(0.25, 0.25, 0.27), ks=(0.30, 0.30, 0.30), ns=80)
+    red = s.material("fabric_red", kd=(0.55, 0.08, 0.07))
+    navy = s.material("fabric_navy", kd=(0.08, 0.12, 0.35))
+    part = s.material("partition", kd=(0.35, 0.45, 0.32))
+    black = s.material("screen", kd=(0.03, 0.03, 0.03), ks=(0.2, 0.2, 0.2), ns=200)
+    books = [s.material("book_%d" % i, kd=c) for i, c in enumerate(
+        [(0.6, 0.1, 0.1), (0.1, 0.2, 0.5), (0.7, 0.6, 0.3), (0.15, 0.4, 0.15),
+         (0.75, 0.75, 0.7), (0.3, 0.15, 0.3)])]
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(12, 12, 12))
+    # west wall (x = 0) blue, north wall (z = D) terracotta, the rest white
+    s.shell(0, W, 0, D, H, T, white, floor, ceil, {"-x": blue, "+z": terra})
+
+    # lit half: x < 3; three panels over it
+    s.group("lights")
+    for cz in (0.8, 2.0, 3.2):
+        s.light(1.5, cz, 1.2, 0.6, H - 0.01, lamp)
+
+    s.group("partition")  # a screen 1.7 m high from the south wall
+    s.box((3.15, 0, -0.05), (3.2, 1.7, 2.6), part)
+    s.box((3.1, 0, 2.6), (3.25, 1.72, 2.65), metal)
+
+    s.group("desks")
+    desk(s, 0.5, 0.15, 1.6, 0.8, wood, metal)     # lit half, against the south wall
+    desk(s, 0.9, 3.05, 1.6, 0.8, wood, metal)     # lit half, against the north wall
+    desk(s, 4.0, 0.15, 1.6, 0.8, wood, metal)     # dark half
+    s.group("monitors")
+    for (mx, mz) in ((1.3, 0.35), (4.8, 0.35)):
+        s.box((mx - 0.28, 0.85, mz), (mx + 0.28, 1.2, mz + 0.03), black)
+        s.box((mx - 0.03, 0.75, mz), (mx + 0.03, 0.85, mz + 0.06), metal)
+        s.box((mx - 0.12, 0.75, mz - 0.05), (mx + 0.12, 0.76, mz + 0.12), metal)
+    s.group("chairs")
+    chair(s, 1.3, 1.35, navy, metal, facing=0)
+    chair(s, 1.7, 2.75, red, metal, facing=180)
+    chair(s, 4.8, 1.4, navy, metal, facing=-10)
+    chair(s, 5.0, 2.6, red, metal, facing=60)
+    s.group("shelves")
+    shelf(s, 0.0, 1.45, 1.2, 0.35, 2.0, wood, books, seed=1, along="z")  # on the west wall
+    s.group("shelves_dark")
+    # against the east wall; rotated: books face -x
+    s.box((5.55, 0, 1.3), (6.0, 1.0, 2.5), wood)                           # low cabinet
+    shelf(s, 5.6, 2.6, 1.2, 0.4, 2.2, wood, books, seed=2, along="z", flip=True)
+    s.group("table")
+    s.box((3.6, 0.70, 3.0), (4.6, 0.74, 3.8), wood)
+    s.box((4.05, 0, 3.35), (4.15, 0.70, 3.45), metal)
+    s.camera = ((3.0, 1.9, 3.85), (3.0, 0.8, 0.0), 60)
+    s.note = ("Office-like interior, %g x %g x %g m, stand-in for Kollig & Keller 2004 Fig. 6 "
+              "'office'. Three ceiling panels (1.2 x 0.6 m, Ke 12) over the west half (x < 3); "
+              "a 1.7 m partition screen at x = 3.2 shades the east half, which is lit mostly "
+              "indirectly. Blue west wall, terracotta north wall.") % (W, D, H)
+    return s
+
+
+def conference():
+    s = Scene("conference")
+    W, D, H, T = 10.0, 6.0, 3.0, 0.2
+    beige = s.material("wall_beige", kd=(0.70, 0.66, 0.58))
+    accent = s.material("wall_bluegrey", kd=(0.30, 0.38, 0.48))
+    floor = s.material("carpet", kd=(0.22, 0.24, 0.30))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood_table", kd=(0.45, 0.28, 0.15), ks=(0.06, 0.06, 0.06), ns=80)
+    door_m = s.material("wood_door", kd=(0.55, 0.40, 0.25))
+    metal = s.material("metal", kd=(0.25, 0.25, 0.27), ks=(0.30, 0.30, 0.30), ns=80)
+    seat = s.material("fabric_black", kd=(0.06, 0.06, 0.07))
+    board = s.material("whiteboard", kd=(0.78, 0.78, 0.78), ks=(0.1, 0.1, 0.1), ns=300)
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(14, 14, 14))
+
+    s.group("floor")
+    s.box((-T, -T, -T), (W + T, 0, D + T), floor)
+    s.group("ceiling")
+    s.box((-T, H, -T), (W + T, H + T, D + T), ceil)
+    s.group("walls")
+    s.box((-T, -0.1, -T), (0, H + 0.1, D + T), beige)               # west
+    s.box((W, -0.1, -T), (W + T, H + 0.1, D + T), beige, {"-x": accent})  # east
+    s.box((-T, -0.1, D), (W + T, H + 0.1, D + T), beige)            # north
+    # south wall with a door recess: opening x in [4, 5], the door 0.12 m deep in it
+    dx0, dx1 = 4.0, 5.0
+    s.wall("x", -T / 2, -T / 2, W + T / 2, T, beige, doors=[(dx0, dx1)], y0=-0.1,
+           y1=H + 0.1)
+    s.group("door")
+    s.box((dx0 - 0.05, -0.05, -T), (dx1 + 0.05, H_DOOR + 0.05, -0.12), door_m)
+    s.box((dx1 - 0.15, 0.98, -0.12), (dx1 - 0.05, 1.02, -0.07), metal)   # handle
+
+    s.group("lights")
+    for cx in (3.0, 5.0, 7.0):
+        for cz in (2.1, 3.9):
+            s.light(cx, cz, 0.6, 0.6, H - 0.01, lamp)
+
+    s.group("table")
+    tx0, tx1, tz0, tz1 = 2.0, 8.0, 2.3, 3.7
+    s.box((tx0, 0.71, tz0), (tx1, 0.76, tz1), wood)
+    for lx in (2.5, 7.4):
+        s.box((lx, 0, 2.6), (lx + 0.1, 0.71, 3.4), metal)
+    s.box((2.6, 0.55, 2.95), (7.4, 0.65, 3.05), metal)
+    s.group("chairs")
+    n = 0
+    for cx in (2.8, 3.9, 5.0, 6.1, 7.2):
+        chair(s, cx, tz0 - 0.45, seat, metal, facing=180)
+        chair(s, cx, tz1 + 0.45, seat, metal, facing=0)
+        n += 2
+    chair(s, tx0 - 0.45, 3.0, seat, metal, facing=-90)
+    chair(s, tx1 + 0.45, 3.0, seat, metal, facing=90)
+    n += 2
+    s.group("whiteboard")
+    s.box((0, 0.9, 1.5), (0.03, 2.1, 4.5), board)
+    s.group("sideboard")
+    s.box((6.0, 0, 5.5), (9.0, 0.9, 6.0), wood)
+    s.camera = ((9.6, 2.1, 5.0), (2.5, 0.5, 1.8), 60)
+    s.note = ("Conference-room-like interior, %g x %g x %g m, stand-in for Kollig & Keller "
+              "2004 'conference room'. A 6 x 1.4 m table with %d chairs, six 0.6 x 0.6 m "
+              "ceiling panels (Ke 14) over the table, a door recessed 0.12 m into the south "
+              "wall, a whiteboard on the west wall, a blue-grey east wall. The floor under the "
+              "table is lit only indirectly.") % (W, D, H, n)
+    return s
+
+
+def rooms10x10():
+    s = Scene("rooms10x10")
+    N, P, T, H = 10, 4.2, 0.2, 3.0   # rooms per side, grid pitch, wall thickness, height
+    wall_a = s.material("wall_warm", kd=(0.72, 0.68, 0.60))
+    wall_b = s.material("wall_cool", kd=(0.60, 0.66, 0.72))
+    floor = s.material("floor", kd=(0.40, 0.36, 0.32))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood", kd=(0.50, 0.34, 0.20))
+    cols = [s.material("box_%d" % i, kd=c) for i, c in enumerate(
+        [(0.6, 0.15, 0.1), (0.15, 0.45, 0.15), (0.15, 0.2, 0.55), (0.7, 0.6, 0.2)])]
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(16, 16, 16))
+    L = N * P   # wall centre lines at 0, P, ..., N P; room interiors 4.0 m square
+    s.group("floor")
+    s.box((-T / 2, -T, -T / 2), (L + T / 2, 0, L + T / 2), floor)
+    s.group("ceiling")
+    s.box((-T / 2, H, -T / 2), (L + T / 2, H + T, L + T / 2), ceil)
+
+    def door(k, parity):
+        """door gap along the wall segment [k P, (k+1) P]: near one end or the other"""
+        return (k * P + 0.8, k * P + 1.8) if parity == 0 else (k * P + 2.4, k * P + 3.4)
+    s.group("walls_x")   # walls running along x, at z = j P
+    for j in range(N + 1):
+        if j in (0, N):
+            s.wall("x", j * P, 0, L, T, wall_a, y1=H + 0.1)
+        else:
+            for i in range(N):
+                s.wall("x", j * P, i * P, (i + 1) * P, T, wall_a,
+                       doors=[door(i, (i + j) % 2)], y1=H + 0.1)
+    s.group("walls_z")   # walls running along z, at x = i P
+    for i in range(N + 1):
+        if i in (0, N):
+            s.wall("z", i * P, 0, L, T, wall_b, y1=H + 0.1)
+        else:
+            for j in range(N):
+                s.wall("z", i * P, j * P, (j + 1) * P, T, wall_b,
+                       doors=[door(j, (i + j + 1) % 2)], y1=H + 0.1)
+    s.group("lights")
+    for j in range(N):
+        for i in range(N):
+            s.light((i + 0.5) * P, (j + 0.5) * P, 0.6, 0.6, H - 0.01, lamp)
+    s.group("furniture")
+    rng = random.Random(10)
+    for j in range(N):
+        for i in range(N):
+            x0, z0 = i * P + T / 2, j * P + T / 2   # interior corner
+            # a table somewhere in the middle and a cabinet against the back wall
+            tx = x0 + rng.uniform(0.8, 2.0)
+            tz = z0 + rng.uniform(1.0, 2.0)
+            desk(s, tx, tz, 1.2, 0.7, wood, wood, h=0.72, top=0.04, leg=0.06)
+            # keep clear of the door in the north wall (line j + 1)
+            if (i + j + 1) % 2 == 0:      # door at x0 + [0.7, 1.7]
+                cx = x0 + rng.uniform(2.0, 3.2)
+            else:                          # door at x0 + [2.3, 3.3]
+                cx = x0 + rng.uniform(0.1, 1.5)
+            s.box((cx, 0, z0 + 4.0 - 0.45), (cx + 0.7, rng.uniform(0.8, 1.8), z0 + 4.0 - 0.01),
+                  cols[rng.randrange(len(cols))])
+    # camera in room (4, 4), in its south-west corner looking north-east at the
+    # two doors leading to rooms (4, 5) and (5, 4)
+    x0, z0 = 4 * P + T / 2, 4 * P + T / 2
+    s.camera = ((x0 + 0.3, 1.6, z0 + 0.3), (x0 + 3.3, 1.1, z0 + 3.4), 60)
+    s.note = ("%d x %d rooms of 4 x 4 x %g m on a %g m grid (walls %g m thick), each interior "
+              "wall with a 1 x %g m door gap near one end or the other (alternating), one 0.6 "
+              "x 0.6 m ceiling panel (Ke 16) per room, a table and a cabinet per room. "
+              "Stand-in for Keller & Wald 2000 Figs. 1-2. The camera is in room (4, 4) "
+              "(x, z in [16.9, 20.9]) looking at its doors to rooms (5, 4) and (4, 5).") % (
+        N, N, H, P, T, H_DOOR)
+    return s
+
+
+def doorslit():
+    s = Scene("doorslit")
+    W, D, H, T = 4.0, 4.0, 3.0, 0.2     # each room W x D x H
+    white = s.material("wall_white", kd=(0.75, 0.74, 0.71))
+    floor = s.material("floor", kd=(0.45, 0.40, 0.34))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    door_m = s.material("wood_door", kd=(0.60, 0.45, 0.30))
+    red = s.material("fabric_red", kd=(0.55, 0.08, 0.07))
+    blue = s.material("wall_blue", kd=(0.25, 0.35, 0.60))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(20, 20, 20))
+    X1 = W + T          # right room interior x in [X1, X1 + W]
+    # both rooms in one shell, split by the shared wall at x in [W, W + T]
+    s.shell(0, X1 + W, 0, D, H, T, white, floor, ceil, {"+x": blue})
+    s.group("shared_wall")
+    z0, z1 = 1.5, 2.4   # door opening
+    s.wall("z", W + T / 2, -T / 2, D + T / 2, T, white, doors=[(z0, z1)], y1=H + 0.1)
+    # The door (0.9 x 0.04 m) is hinged at z0 on the wall's centre line and opened
+    # into the left room by the angle that leaves a 5 cm gap between its free edge
+    # and the frame.
+    s.group("door")
+    hx, dt, dw, gap = W + T / 2, 0.04, z1 - z0, 0.05
+
+    def free_corner(a):  # right (+x) face corner of the free edge, door opened by a
+        ca, sa = math.cos(a), math.sin(a)
+        return (hx + dt / 2 * ca - dw * sa, z0 + dt / 2 * sa + dw * ca)
+    lo_a, hi_a = 0.0, 0.5
+    for _ in range(60):
+        mid = (lo_a + hi_a) / 2
+        fx, fz = free_corner(mid)
+        if math.hypot(W - fx, z1 - fz) < gap:
+            lo_a = mid
+        else:
+            hi_a = mid
+    ang = math.degrees(lo_a)
+    # box in the closed position (centred on x = hx, z from z0 - 0.03 into the
+    # frame to z1 - 0.003), then turned about the hinge by -ang (clockwise seen from
+    # above), which moves the free edge (+z) towards -x.
+    s.box((hx - dt / 2, -0.02, z0 - 0.03), (hx + dt / 2, H_DOOR + 0.01, z1 - 0.003), door_m,
+          rot=(-ang, (hx, z0)))
+    s.group("light")
+    s.light(W / 2, D / 2, 1.0, 1.0, H - 0.01, lamp)
+    s.group("furniture")
+    chair(s, 1.2, 1.2, red, door_m, facing=30)
+    s.box((X1 + 2.6, 0, 2.8), (X1 + 3.8, 0.75, 3.8), door_m)   # a crate in the right room
+    s.box((X1 + 0.8, 0, 0.4), (X1 + 1.3, 0.5, 0.9), red)
+    s.camera = ((X1 + W - 0.3, 1.5, D - 0.3), (W + T, 1.0, 1.6), 60)
+    s.note = ("Two rooms of %g x %g x %g m side by side (x in [0, 4] and [4.2, 8.2]); the "
+              "shared wall has a 0.9 x 2.1 m door opening at z in [1.5, 2.4] whose door is "
+              "opened %.1f degrees into the left room, leaving a 5 cm gap between its free "
+              "edge and the frame. The only light, a 1 x 1 m panel (Ke 20), is in the left "
+              "room; the camera is in the right room looking at the shared wall, so everything "
+              "it sees is lit through the slit. Stand-in for Keller & Wald 2000 Fig. 4.") % (
+        W, D, H, ang)
+    return s
+
+
+def floor_many_lights():
+    s = Scene("floor_many_lights")
+    W, D, H, T = 40.0, 20.0, 3.0, 0.2
+    wall_m = s.material("wall_white", kd=(0.72, 0.70, 0.66))
+    corr_m = s.material("wall_corridor", kd=(0.55, 0.62, 0.58))
+    floor = s.material("floor", kd=(0.38, 0.36, 0.34))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood", kd=(0.50, 0.34, 0.20))
+    metal = s.material("metal", kd=(0.25, 0.25, 0.27), ks=(0.3, 0.3, 0.3), ns=80)
+    seat = s.material("fabric_navy", kd=(0.08, 0.12, 0.35))
+    cols = [s.material("cabinet_%d" % i, kd=c) for i, c in enumerate(
+        [(0.6, 0.15, 0.1), (0.15, 0.45, 0.15), (0.7, 0.6, 0.2), (0.5, 0.5, 0.5)])]
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(10, 10, 10))
+    # wall centre lines; outer walls centred on x = 0, W and z = 0, D
+    s.group("floor")
+    s.box((-T / 2, -T, -T / 2), (W + T / 2, 0, D + T / 2), floor)
+    s.group("ceiling")
+    s.box((-T / 2, H, -T / 2), (W + T / 2, H + T, D + T / 2), ceil)
+    s.group("walls")
+    y1 = H + 0.1
+    s.wall("x", 0, 0, W, T, wall_m, y1=y1)
+    s.wall("x", D, 0, W, T, wall_m, y1=y1)
+    s.wall("z", 0, 0, D, T, wall_m, y1=y1)
+    s.wall("z", W, 0, D, T, wall_m, y1=y1)
+    # rows of offices (z ranges) and the corridors between them:
+    #   south offices z in [0, 5], corridor A [5, 7], middle rows [7, 10] and [10, 13]
+    #   (split at x in [19, 21] by a cross corridor), corridor B [13, 15], north [15, 20]
+    offices = []   # (x0, x1, z0, z1, door wall z, door (d0, d1))
+    xs_full = [5.0 * k for k in range(9)]
+    xs_mid = [0.0, 4.75, 9.5, 14.25, 19.0, 21.0, 25.75, 30.5, 35.25, 40.0]
+
+    def door_at(x0, x1, k):
+        return (x0 + 0.6, x0 + 1.6) if k % 2 == 0 else (x1 - 1.6, x1 - 0.6)
+    for k in range(8):
+        x0, x1 = xs_full[k], xs_full[k + 1]
+        offices.append((x0, x1, 0.0, 5.0, 5.0, door_at(x0, x1, k)))
+        offices.append((x0, x1, 15.0, 20.0, 15.0, door_at(x0, x1, k + 1)))
+    for k in range(9):
+        if k == 4:
+            continue   # the cross corridor
+        x0, x1 = xs_mid[k], xs_mid[k + 1]
+        offices.append((x0, x1, 7.0, 10.0, 7.0, door_at(x0, x1, k + 1)))
+        offices.append((x0, x1, 10.0, 13.0, 13.0, door_at(x0, x1, k)))
+    # corridor walls with the doors of the offices on them
+    for zc in (5.0, 7.0, 13.0, 15.0):
+        for (x0, x1, oz0, oz1, dz, d) in offices:
+            if dz == zc:
+                s.wall("x", zc, x0, x1, T, corr_m, doors=[d], y1=y1)
+    # the cross corridor's side walls and the walls between the two middle rows
+    s.wall("z", 19.0, 7.0, 13.0, T, corr_m, y1=y1)
+    s.wall("z", 21.0, 7.0, 13.0, T, corr_m, y1=y1)
+    s.wall("x", 10.0, 0.0, 19.0, T, wall_m, y1=y1)
+    s.wall("x", 10.0, 21.0, 40.0, T, wall_m, y1=y1)
+    # walls between neighbouring offices
+    for k in range(1, 8):
+        s.wall("z", xs_full[k], 0.0, 5.0, T, wall_m, y1=y1)
+        s.wall("z", xs_full[k], 15.0, 20.0, T, wall_m, y1=y1)
+    for k in range(1, 9):
+        if xs_mid[k] in (19.0, 21.0):
+            continue
+        s.wall("z", xs_mid[k], 7.0, 10.0, T, wall_m, y1=y1)
+        s.wall("z", xs_mid[k], 10.0, 13.0, T, wall_m, y1=y1)
+
+    s.group("lights")
+    for (x0, x1, z0, z1, dz, d) in offices:   # 2 x 2 panels per office
+        for fx in (0.28, 0.72):
+            for fz in (0.3, 0.7):
+                s.light(x0 + fx * (x1 - x0), z0 + fz * (z1 - z0), 0.6, 0.6, H - 0.01, lamp)
+    for zc in (6.0, 14.0):                     # corridors: one every 4 m
+        for k in range(10):
+            s.light(2.0 + 4.0 * k, zc, 0.6, 0.6, H - 0.01, lamp)
+    s.light(20.0, 10.0, 0.6, 0.6, H - 0.01, lamp)   # cross corridor
+
+    s.group("furniture")
+    rng = random.Random(5)
+    for (x0, x1, z0, z1, dz, d) in offices:
+        # a desk against the outer (non-door) wall, a chair, a cabinet in a corner
+        back = z0 + T / 2 if dz == z1 else z1 - T / 2   # inner face of the wall opposite the door
+        w = 1.6
+        dx = x0 + T / 2 + rng.uniform(0.4, (x1 - x0) - T - w - 0.7)
+        if back < dz:
+            desk(s, dx, back + 0.05, w, 0.8, wood, metal)
+            chair(s, dx + w / 2, back + 1.3, seat, metal, facing=rng.uniform(-30, 30))
+        else:
+            desk(s, dx, back - 0.85, w, 0.8, wood, metal)
+            chair(s, dx + w / 2, back - 1.3, seat, metal, facing=180 + rng.uniform(-30, 30))
+        # a cabinet against the side wall away from the door, half way between the
+        # door wall and the back wall
+        zm = (z0 + z1) / 2
+        if d[0] - x0 < x1 - d[1]:
+            cx0 = x1 - T / 2 - 0.46
+        else:
+            cx0 = x0 + T / 2 + 0.01
+        s.box((cx0, 0, zm - 0.4), (cx0 + 0.45, rng.uniform(1.0, 2.0), zm + 0.4),
+              cols[rng.randrange(len(cols))])
+    # camera in the south office at x in [15, 20], from its south-west corner towards
+    # its door (x in [18.4, 19.4]) onto corridor A
+    s.camera = ((15.4, 1.7, 0.45), (18.9, 1.1, 5.5), 60)
+    s.note = ("A building floor of %g x %g x %g m: %d offices in four rows (two rows of "
+              "5 x 5 m, two back-to-back rows of 4.75 x 3 m split by a cross corridor), two "
+              "2 m corridors along x joined by the cross corridor; 1 x %g m door gaps. 4 "
+              "ceiling panels (0.6 x 0.6 m, Ke 10) per office, one every 4 m in the "
+              "corridors. Each office has a desk, a chair and a cabinet. Stand-in for Keller & "
+              "Wald 2000 Fig. 5 and Bekaert et al. 2003 Fig. 6. The camera is in the south "
+              "office at x in [15, 20] looking at its door onto corridor A.") % (
+        W, D, H, len(offices), H_DOOR)
+    return s
+
+
+def caustic_ring():
+    s = Scene("caustic_ring")
+    R, H, T = 2.0, 2.5, 0.2       # room x, z in [-R, R], height H
+    wall = s.material("wall_grey", kd=(0.55, 0.55, 0.55))
+    floor = s.material("floor", kd=(0.70, 0.68, 0.64))
+    ceil = s.material("ceiling", kd=(0.70, 0.70, 0.70))
+    mirror = s.material("mirror", kd=(0, 0, 0), ks=(0.95, 0.93, 0.88), illum=5)
+    glass = s.material("glass", kd=(0, 0, 0), ks=(1, 1, 1), ni=1.5, illum=7)
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(60, 60, 60))
+    s.shell(-R, R, -R, R, H, T, wall, floor, ceil)
+    s.group("light")
+    s.light(-1.5, -0.6, 0.25, 0.25, H - 0.01, lamp)
+    s.group("ring")
+    s.ring(0.35, 0.25, 0.40, 0.41, 0.22, mirror)
+    s.group("sphere")
+    s.sphere((-0.55, 0.3, 0.55), 0.3, glass)
+    s.camera = ((1.5, 1.7, 1.9), (-0.1, 0.1, 0.2), 50)
+    s.note = ("A closed 4 x 4 x %g m room with a diffuse floor, a mirror ring (illum 5, "
+              "radius 0.4 m, 0.22 m high, smooth vertex normals) and a glass sphere (illum 7, "
+              "Ni 1.5, radius 0.3 m, smooth vertex normals); one small 0.25 x 0.25 m ceiling "
+              "panel (Ke 60) off to the side casts a cardioid caustic inside the ring and a "
+              "focused caustic behind the sphere.") % H
+    return s
+
+
+SCENES = {
+    "office": office,
+    "conference": conference,
+    "rooms10x10": rooms10x10,
+    "doorslit": doorslit,
+    "floor_many_lights": floor_many_lights,
+    "caustic_ring": caustic_ring,
+}
+
+
+def main(argv):
+    if len(argv) < 2 or argv[1] in ("-h", "--help"):
+        sys.stderr.write("usage: %s OUTDIR [NAME ...]\nscenes: %s\n" % (
+            argv[0], " ".join(SCENES)))
+        return 2
+    outdir = argv[1]
+    names = argv[2:] or list(SCENES)
+    for n in names:
+        if n not in SCENES:
+            sys.stderr.write("%s: unknown scene '%s' (scenes: %s)\n" % (
+                argv[0], n, " ".join(SCENES)))
+            return 2
+    os.makedirs(outdir, exist_ok=True)
+    for n in names:
+        s = SCENES[n]()
+        s.write(outdir)
+        print("%-18s %7d triangles, %4d light panels (%d emitting triangles), %.2f m^2 of light;"
+              " camera: %s" % (n, s.triangles(), s.light_panels, s.emitting_triangles(),
+                               s.light_area,
+                               open(os.path.join(outdir, n + ".cam")).read().strip()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
