@@ -40,6 +40,7 @@ typedef struct render_args {
     long light_paths, interleave;
     double threshold, clamp;
     int strata_distance, single_shadow_rays;
+    int aov_pathlength, aov_strata;
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;
@@ -76,6 +77,9 @@ static void render_help(void)
            "      --interleave N      N x N interleaved sets of the K paths (default 1)\n"
            "      --clamp c           ir: clamp G at c (default: 1 / (0.05 d)^2)\n"
            "      --strata KIND       rigi: geometry (threshold G, default) or distance\n"
+           "      --aov NAME          rigi: extra EXR layers: pathlength (average eye path\n"
+           "                          length, Fig. 4) or strata (the contribution of each\n"
+           "                          eye path length as layers strata1..strata8, Fig. 5)\n"
            "      --shadow-rays KIND  rigi/ir: bundle (one Embree stream per point light and\n"
            "                          tile, default) or single\n"
            "  -q, --quiet             no warnings, no progress bar\n"
@@ -141,7 +145,7 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                                        "--res", "--lookat", "--fov", "--maxdepth", "--seed",
                                        "--threads", "--point-light", "--exposure", "--sampler",
                                        "--mis", "--light-paths", "--interleave", "--threshold",
-                                       "--clamp", "--strata", "--shadow-rays"};
+                                       "--clamp", "--strata", "--shadow-rays", "--aov"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(o, valued[k]);
@@ -222,6 +226,13 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->strata_distance = 1;
             else
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected geometry or distance, got '%s'", v);
+        } else if (!strcmp(o, "--aov")) {
+            if (!strcmp(v, "pathlength"))
+                a->aov_pathlength = 1;
+            else if (!strcmp(v, "strata"))
+                a->aov_strata = 1;
+            else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected pathlength or strata, got '%s'", v);
         } else if (!strcmp(o, "--shadow-rays")) {
             if (!strcmp(v, "bundle"))
                 a->single_shadow_rays = 0;
@@ -244,6 +255,13 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "%ld paths cannot fill %ld x %ld interleaved sets", a->light_paths,
                              a->interleave, a->interleave);
+    if (a->aov_pathlength || a->aov_strata) {
+        int exr = 0;
+        for (int i = 0; i < a->nout; i++)
+            exr |= cdl_image_has_ext(a->out[i], ".exr");
+        if (!exr)
+            return cdl_error_set(err, CDL_ERR_USAGE, "--aov", 0, "output layers need an .exr output (-o FILE.exr)");
+    }
     if (a->spp && a->time > 0.0)
         return cdl_error_set(err, CDL_ERR_USAGE, "--time", 0, "give either --spp or --time, not both");
     return 0;
@@ -361,6 +379,14 @@ int cdl_cmd_render(int argc, char **argv)
                            a.integrator);
     if (!rc)
         rc = cdl_film_init(&film, a.width, a.height, &err);
+    if (!rc && a.aov_pathlength && cdl_film_add_aov(&film, "pathlength", 1, &err) < 0)
+        rc = err.code;
+    for (int k = 1; !rc && a.aov_strata && k <= CDL_STRATA; k++) {
+        char nm[32];
+        snprintf(nm, sizeof nm, "strata%d", k);
+        if (cdl_film_add_aov(&film, nm, 3, &err) < 0)
+            rc = err.code;
+    }
     if (rc) {
         int status = cdl_report(&err);
         cdl_integrator_destroy(&integ);
@@ -404,8 +430,21 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_kv meta[] = {{"integrator", a.integrator}, {"spp", s_spp}, {"seed", s_seed},
                      {"renderTime", s_time},       {"commandLine", cmdline}};
     rc = cdl_film_resolve(&film, &img, &err);
+    cdl_image aov_img[CDL_MAX_AOVS];
+    cdl_layer layers[CDL_MAX_AOVS];
+    int nl = 0;
+    for (int i = 0; !rc && i < film.naovs; i++) {
+        memset(&aov_img[i], 0, sizeof aov_img[i]);
+        rc = cdl_film_resolve_aov(&film, i, &aov_img[i], &err);
+        layers[i] = (cdl_layer){film.aovs[i].name, &aov_img[i], film.aovs[i].channels == 1};
+        nl = i + 1;
+    }
     for (int i = 0; !rc && i < a.nout; i++)
-        rc = cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
+        rc = nl && cdl_image_has_ext(a.out[i], ".exr")
+                 ? cdl_image_write_layers(a.out[i], &img, layers, nl, meta, 5, &err)
+                 : cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
+    for (int i = 0; i < nl; i++)
+        cdl_image_free(&aov_img[i]);
     int status = rc ? cdl_report(&err) : 0;
     if (!rc) {
         double mrays = t_render > 0.0 ? (double)film.rays / t_render * 1e-6 : 0.0;

@@ -63,8 +63,29 @@ static int exr_open(const char *path, exr_context_t *ctx, exr_msg *m,
 
 /* ---- writing ---------------------------------------------------------- */
 
+/* Where the pixels of channel `ch` ("R" or "layer.G") come from. */
+static const float *channel_source(const char *ch, const cdl_image *img, const cdl_layer *layers,
+                                   int nlayers)
+{
+    const char *dot = strrchr(ch, '.');
+    const cdl_image *src = img;
+    const char *suffix = ch;
+    if (dot) {
+        src = NULL;
+        for (int i = 0; i < nlayers && !src; i++)
+            if (strlen(layers[i].name) == (size_t)(dot - ch) && !strncmp(layers[i].name, ch, (size_t)(dot - ch)))
+                src = layers[i].img;
+        suffix = dot + 1;
+    }
+    if (!src)
+        return NULL;
+    int off = suffix[0] == 'G' ? 1 : suffix[0] == 'B' ? 2 : 0; /* R and Y */
+    return src->rgb + off;
+}
+
 int cdl_exr_write(const char *file, const char *name, const cdl_image *img,
-                  const cdl_kv *meta, int nmeta, cdl_error *err)
+                  const cdl_layer *layers, int nlayers, const cdl_kv *meta, int nmeta,
+                  cdl_error *err)
 {
     exr_msg m = {{0}};
     exr_context_initializer_t ci = exr_init(&m);
@@ -88,6 +109,14 @@ int cdl_exr_write(const char *file, const char *name, const cdl_image *img,
     for (int c = 0; c < 3 && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_add_channel(ctx, part, names[c], EXR_PIXEL_FLOAT,
                              EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    for (int l = 0; l < nlayers && rv == EXR_ERR_SUCCESS; l++) {
+        static const char *sfx[4] = {"R", "G", "B", "Y"};
+        for (int c = layers[l].grey ? 3 : 0; c < (layers[l].grey ? 4 : 3) && rv == EXR_ERR_SUCCESS; c++) {
+            char ch[96];
+            snprintf(ch, sizeof ch, "%s.%s", layers[l].name, sfx[c]);
+            rv = exr_add_channel(ctx, part, ch, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        }
+    }
     for (int i = 0; i < nmeta && rv == EXR_ERR_SUCCESS; i++) {
         what = "cannot add metadata attribute";
         rv = exr_attr_set_string(ctx, part, meta[i].key, meta[i].value);
@@ -112,10 +141,12 @@ int cdl_exr_write(const char *file, const char *name, const cdl_image *img,
         have_enc = 1;
         for (int c = 0; c < enc.channel_count; c++) {
             exr_coding_channel_info_t *ch = &enc.channels[c];
-            int off = ch->channel_name[0] == 'R' ? 0
-                      : ch->channel_name[0] == 'G' ? 1 : 2;
-            ch->encode_from_ptr =
-                (const uint8_t *)(img->rgb + 3 * (size_t)y * w + off);
+            const float *src = channel_source(ch->channel_name, img, layers, nlayers);
+            if (!src) {
+                rv = EXR_ERR_INVALID_ARGUMENT;
+                break;
+            }
+            ch->encode_from_ptr = (const uint8_t *)(src + 3 * (size_t)y * w);
             ch->user_pixel_stride = 3 * sizeof(float);
             ch->user_line_stride = 3 * sizeof(float) * w;
             ch->user_data_type = EXR_PIXEL_FLOAT;

@@ -1,6 +1,7 @@
 #include "film/film.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,9 +25,58 @@ void cdl_film_free(cdl_film *f)
     free(f->sum);
     free(f->count);
     free(f->splat);
+    for (int i = 0; i < f->naovs; i++)
+        free(f->aovs[i].sum);
+    free(f->aovs);
     f->sum = NULL;
     f->count = NULL;
     f->splat = NULL;
+    f->aovs = NULL;
+    f->naovs = 0;
+}
+
+int cdl_film_add_aov(cdl_film *f, const char *name, int channels, cdl_error *err)
+{
+    if (f->naovs >= CDL_MAX_AOVS || (channels != 1 && channels != 3)) {
+        cdl_error_set(err, CDL_ERR_USAGE, "--aov", 0, "too many output layers");
+        return -1;
+    }
+    if (!f->aovs && !(f->aovs = calloc(CDL_MAX_AOVS, sizeof(cdl_aov)))) {
+        cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");
+        return -1;
+    }
+    cdl_aov *a = &f->aovs[f->naovs];
+    snprintf(a->name, sizeof a->name, "%s", name);
+    a->channels = channels;
+    a->sum = calloc((size_t)channels * (size_t)f->width * (size_t)f->height, sizeof(double));
+    if (!a->sum) {
+        cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for layer %s", name);
+        return -1;
+    }
+    return f->naovs++;
+}
+
+int cdl_film_find_aov(const cdl_film *f, const char *name)
+{
+    for (int i = 0; i < f->naovs; i++)
+        if (!strcmp(f->aovs[i].name, name))
+            return i;
+    return -1;
+}
+
+int cdl_film_resolve_aov(const cdl_film *f, int a, cdl_image *img, cdl_error *err)
+{
+    int rc = cdl_image_alloc(img, f->width, f->height, err);
+    if (rc)
+        return rc;
+    const cdl_aov *av = &f->aovs[a];
+    size_t n = (size_t)f->width * (size_t)f->height;
+    for (size_t i = 0; i < n; i++) {
+        double w = f->count[i] ? 1.0 / f->count[i] : 0.0;
+        for (int k = 0; k < 3; k++)
+            img->rgb[3 * i + k] = (float)(av->sum[(size_t)av->channels * i + (av->channels == 3 ? k : 0)] * w);
+    }
+    return 0;
 }
 
 int cdl_splats_add(cdl_splats *sp, uint32_t pixel, cdl_vec3 L)

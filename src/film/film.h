@@ -20,7 +20,26 @@ typedef struct cdl_film {
      * in a fixed order and divided by the passes at the end. */
     double *splat;      /* 3 per pixel, NULL until the first splat */
     uint32_t splat_passes;
+    /* Arbitrary output variables: per-pixel sums averaged like the image
+     * (an integrator that fills one adds to it once per pixel sample). */
+    struct cdl_aov *aovs;
+    int naovs;
 } cdl_film;
+
+#define CDL_MAX_AOVS 16
+
+typedef struct cdl_aov {
+    char name[32];
+    int channels; /* 1 or 3 */
+    double *sum;  /* channels per pixel */
+} cdl_aov;
+
+/* Adds an AOV layer (before rendering); returns its index or -1. */
+int cdl_film_add_aov(cdl_film *f, const char *name, int channels, cdl_error *err);
+/* Index of the AOV called name, or -1. */
+int cdl_film_find_aov(const cdl_film *f, const char *name);
+/* Averages AOV a into img (allocated here; 1-channel AOVs fill R = G = B). */
+int cdl_film_resolve_aov(const cdl_film *f, int a, cdl_image *img, cdl_error *err);
 
 /* Splats gathered by one tile or one batch of light paths during a pass;
  * merged into the film in a fixed order so that passes stay deterministic. */

@@ -337,8 +337,8 @@ static int png_read(const char *path, FILE *f, cdl_image *img, cdl_error *err)
 
 /* ---- dispatch --------------------------------------------------------- */
 
-int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
-                    int nmeta, float exposure, cdl_error *err)
+static int write_any(const char *path, const cdl_image *img, const cdl_layer *layers, int nlayers,
+                     const cdl_kv *meta, int nmeta, float exposure, cdl_error *err)
 {
     enum { EXR, PNG, PFM } fmt;
     if (cdl_image_has_ext(path, ".exr"))
@@ -357,7 +357,9 @@ int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
     if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >=
         (int)sizeof tmp)
         return cdl_error_set(err, CDL_ERR_USAGE, path, 0, "path too long");
-    int status = fmt == EXR ? cdl_exr_write(tmp, path, img, meta, nmeta, err)
+    if (nlayers && fmt != EXR)
+        return cdl_error_set(err, CDL_ERR_USAGE, path, 0, "layers need an .exr file");
+    int status = fmt == EXR ? cdl_exr_write(tmp, path, img, layers, nlayers, meta, nmeta, err)
                  : fmt == PNG
                      ? png_write(tmp, path, img, meta, nmeta, exposure, err)
                      : pfm_write(tmp, path, img, err);
@@ -368,6 +370,21 @@ int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
     if (status)
         remove(tmp);
     return status;
+}
+
+int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
+                    int nmeta, float exposure, cdl_error *err)
+{
+    return write_any(path, img, NULL, 0, meta, nmeta, exposure, err);
+}
+
+int cdl_image_write_layers(const char *path, const cdl_image *img, const cdl_layer *layers,
+                           int nlayers, const cdl_kv *meta, int nmeta, cdl_error *err)
+{
+    for (int i = 0; i < nlayers; i++)
+        if (!layers[i].img || layers[i].img->width != img->width || layers[i].img->height != img->height)
+            return cdl_error_set(err, CDL_ERR_USAGE, path, 0, "layer %s does not match the image", layers[i].name);
+    return write_any(path, img, layers, nlayers, meta, nmeta, 0.0f, err);
 }
 
 int cdl_image_read(const char *path, cdl_image *img, cdl_error *err)

@@ -36,6 +36,16 @@ int cdl_image_write(const char *path, const cdl_image *img, const cdl_kv *meta,
  * the image is the data window), PFM (PF/Pf, either endianness) or PNG
  * (8/16 bit, sRGB decoded to linear, alpha dropped). The format is found
  * from the file's magic bytes. On error img is left zeroed. */
+/* An extra EXR layer: channels "name.R/G/B", or "name.Y" when grey. */
+typedef struct cdl_layer {
+    const char *name;
+    const cdl_image *img;
+    int grey;
+} cdl_layer;
+
+/* Like cdl_image_write for .exr, with extra layers after the RGB image. */
+int cdl_image_write_layers(const char *path, const cdl_image *img, const cdl_layer *layers,
+                           int nlayers, const cdl_kv *meta, int nmeta, cdl_error *err);
 int cdl_image_read(const char *path, cdl_image *img, cdl_error *err);
 
 /* One string attribute of an EXR header into buf (truncated to n-1 chars);

@@ -14,6 +14,8 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#define CDL_STRATA 8 /* --aov strata: eye path lengths 1..7 and 8 or more */
+
 typedef struct cdl_options {
     cdl_camera camera;
     int maxdepth;   /* bounces, as in pbrt: 1 = direct light only */

@@ -86,12 +86,15 @@ static float strata_g(const rigi_state *st, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 p
 /* One candidate shadow ray of a tile: eye vertex -> point light. */
 typedef struct candidate {
     uint32_t pixel;
+    uint32_t depth; /* eye path length at the connecting vertex, for --aov strata */
     cdl_vec3 c; /* contribution if unoccluded */
     cdl_vec3 o, d;
     float tmax;
 } candidate;
 
 typedef struct tile_work {
+    cdl_vec3 strata[256][CDL_STRATA]; /* per pixel, per eye path length */
+    float plen[256];                  /* eye vertices per pixel */
     cdl_vertex_store eye;  /* eye vertices of the tile's pixels */
     uint32_t *eye_pixel;   /* pixel of each eye vertex */
     candidate *cand;
@@ -122,6 +125,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
     const cdl_scene *s = st->scene;
     cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f), beta = cdl_v3(1.0f, 1.0f, 1.0f);
     float tmax = FLT_MAX;
+    int stratum = 0;
     int prev_delta = 1; /* the camera edge is never thresholded */
     cdl_vec3 prev_p = o, prev_n = cdl_v3(0.0f, 0.0f, 0.0f);
     for (int depth = 0;; depth++) {
@@ -139,8 +143,13 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
             strata_g(st, prev_p, prev_n, sf.p, sf.ng) < st->t)
             return L;
         cdl_vec3 wo = cdl_neg(d);
-        if (sf.light >= 0 && (depth == 0 || !st->clamped || prev_delta))
-            L = cdl_add(L, cdl_mul(beta, cdl_light_Le(&s->lights[sf.light], sf.ng, wo)));
+        stratum = depth < CDL_STRATA ? depth : CDL_STRATA - 1;
+        w->plen[pixel] = (float)(depth + 1);
+        if (sf.light >= 0 && (depth == 0 || !st->clamped || prev_delta)) {
+            cdl_vec3 e = cdl_mul(beta, cdl_light_Le(&s->lights[sf.light], sf.ng, wo));
+            L = cdl_add(L, e);
+            w->strata[pixel][stratum] = cdl_add(w->strata[pixel][stratum], e);
+        }
         if (!delta) {
             uint32_t i = w->eye.n;
             if (cdl_vs_reserve(&w->eye, i + 1, NULL))
@@ -156,6 +165,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
             w->eye.mat[i] = sf.mat;
             w->eye.light[i] = sf.light;
             w->eye.flags[i] = 0;
+            w->eye.depth[i] = (uint16_t)stratum;
             w->eye_pixel = realloc(w->eye_pixel, sizeof(uint32_t) * w->eye.cap);
             if (!w->eye_pixel)
                 return L;
@@ -243,6 +253,7 @@ static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const 
                     return;
                 candidate *cd = &w->cand[w->ncand++];
                 cd->pixel = (uint32_t)pix_of[e];
+                cd->depth = w->eye.depth[e];
                 cd->c = c;
                 cdl_vec3 dd = cdl_sub(yp, ep);
                 cd->o = cdl_offset(st->scene, ep, w->eye.ng[e], dd);
@@ -275,8 +286,11 @@ static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const 
                 cdl_occluded_bundle(st->scene, w->ncand, w->bo, w->bd, w->bt, skip, w->blocked);
             }
             for (uint32_t a = 0; a < w->ncand; a++)
-                if (!w->blocked[a])
-                    acc[w->cand[a].pixel] = cdl_add(acc[w->cand[a].pixel], w->cand[a].c);
+                if (!w->blocked[a]) {
+                    const candidate *cd = &w->cand[a];
+                    acc[cd->pixel] = cdl_add(acc[cd->pixel], cd->c);
+                    w->strata[cd->pixel][cd->depth] = cdl_add(w->strata[cd->pixel][cd->depth], cd->c);
+                }
         }
     }
 }
@@ -287,9 +301,11 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     rigi_state *st = self;
     const cdl_camera *cam = &st->opt.camera;
     int tw = x1 - x0, th = y1 - y0, np = tw * th;
-    tile_work w;
-    memset(&w, 0, sizeof w);
-    cdl_vs_init(&w.eye);
+    /* on the heap: the per-pixel strata make it too large for a stack */
+    tile_work *w = calloc(1, sizeof(tile_work));
+    if (!w)
+        return 0;
+    cdl_vs_init(&w->eye);
     cdl_vec3 acc[256];
     int pix_sets[256];
     /* eye paths of every pixel first, so that shadow rays can be bundled */
@@ -302,36 +318,49 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                               (uint64_t)y * (uint64_t)film->width + (uint64_t)x, pass);
             cdl_sampler_2d(&smp, &jx, &jy);
             acc[p] = eye_path(st, &smp, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
-                              (uint32_t)p, &w, rays);
+                              (uint32_t)p, w, rays);
             pix_sets[p] = (int)cdl_light_pool_set(&st->pool, x, y);
         }
     /* group the eye vertices by interleaved set */
-    uint32_t nv = w.eye.n;
+    uint32_t nv = w->eye.n;
     uint32_t *order = malloc(sizeof(uint32_t) * (nv ? nv : 1));
     int *pix_of = malloc(sizeof(int) * (nv ? nv : 1));
     if (order && pix_of) {
         for (uint32_t e = 0; e < nv; e++)
-            pix_of[e] = (int)w.eye_pixel[e];
+            pix_of[e] = (int)w->eye_pixel[e];
         for (uint32_t set = 0; set < st->pool.sets; set++) {
             uint32_t n = 0;
             for (uint32_t e = 0; e < nv; e++)
                 if ((uint32_t)pix_sets[pix_of[e]] == set)
                     order[n++] = e;
-            connect_set(st, &w, set, order, n, pix_of, acc, rays);
+            connect_set(st, w, set, order, n, pix_of, acc, rays);
         }
     }
     uint64_t bad = 0;
-    for (int p = 0; p < np; p++)
-        bad += (uint64_t)cdl_film_add(film, x0 + p % tw, y0 + p / tw, acc[p]);
+    int a_len = cdl_film_find_aov(film, "pathlength"), a_str = cdl_film_find_aov(film, "strata1");
+    for (int p = 0; p < np; p++) {
+        int x = x0 + p % tw, y = y0 + p / tw;
+        size_t pi = (size_t)y * (size_t)film->width + (size_t)x;
+        bad += (uint64_t)cdl_film_add(film, x, y, acc[p]);
+        if (a_len >= 0)
+            film->aovs[a_len].sum[pi] += w->plen[p];
+        for (int k = 0; a_str >= 0 && k < CDL_STRATA; k++) {
+            double *d = film->aovs[a_str + k].sum + 3 * pi;
+            d[0] += w->strata[p][k].x;
+            d[1] += w->strata[p][k].y;
+            d[2] += w->strata[p][k].z;
+        }
+    }
     free(order);
     free(pix_of);
-    cdl_vs_free(&w.eye);
-    free(w.eye_pixel);
-    free(w.cand);
-    free(w.bo);
-    free(w.bd);
-    free(w.bt);
-    free(w.blocked);
+    cdl_vs_free(&w->eye);
+    free(w->eye_pixel);
+    free(w->cand);
+    free(w->bo);
+    free(w->bd);
+    free(w->bt);
+    free(w->blocked);
+free(w);
     return bad;
 }
 
