@@ -37,207 +37,13 @@
 #include "scene/material.h"
 #include "scene/microfacet.h"
 
-#define PI_D 3.14159265358979323846
+#include "test_stats.h"
+
 #define DEG (PI_D / 180.0)
 
-static int failures, checks;
-
-/* Significance of the chi-square tests: 1% for the whole program,
- * Sidak-corrected over its N_CHI2 tests. Seeds are fixed, so a run never
- * flakes; the correction keeps a correct implementation passing with
- * probability 0.99 even when another compiler or -march changes the float
- * bits and so the samples. Real defects give p-values of ~0. */
-#define FAMILY_ALPHA 0.01
+/* Chi-square tests in this program, for the Sidak correction of P_MIN
+ * (test_stats.h). */
 #define N_CHI2 300
-#define P_MIN (1.0 - pow(1.0 - FAMILY_ALPHA, 1.0 / N_CHI2))
-static int chi2_count;
-
-/* Prints "<message> ok" or "<message> FAIL" and counts failures. */
-static void check(int ok, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(ok ? " ok\n" : " FAIL\n");
-    checks++;
-    if (!ok)
-        failures++;
-}
-
-/* ---- double precision vectors ------------------------------------------ */
-
-typedef struct dvec {
-    double x, y, z;
-} dvec;
-
-static dvec dv(double x, double y, double z) { return (dvec){x, y, z}; }
-static dvec dadd(dvec a, dvec b) { return dv(a.x + b.x, a.y + b.y, a.z + b.z); }
-static dvec dsub(dvec a, dvec b) { return dv(a.x - b.x, a.y - b.y, a.z - b.z); }
-static dvec dscale(dvec a, double s) { return dv(a.x * s, a.y * s, a.z * s); }
-static double ddot(dvec a, dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dvec dcross(dvec a, dvec b)
-{
-    return dv(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-static dvec dnorm(dvec a) { return dscale(a, 1.0 / sqrt(ddot(a, a))); }
-static dvec from_f(cdl_vec3 a) { return dv(a.x, a.y, a.z); }
-static cdl_vec3 to_f(dvec a) { return cdl_v3((float)a.x, (float)a.y, (float)a.z); }
-static double dangle(dvec a, dvec b)
-{
-    return atan2(sqrt(ddot(dcross(a, b), dcross(a, b))), ddot(a, b));
-}
-
-typedef struct dframe {
-    dvec t, b, n;
-} dframe;
-
-static dframe dframe_from(dvec n)
-{
-    dframe f;
-    f.n = n;
-    dvec a = fabs(n.x) < 0.7 ? dv(1, 0, 0) : dv(0, 1, 0);
-    f.t = dnorm(dsub(a, dscale(n, ddot(a, n))));
-    f.b = dcross(n, f.t);
-    return f;
-}
-static dvec dframe_dir(const dframe *f, double c, double phi)
-{
-    double s = sqrt(fmax(0.0, 1.0 - c * c));
-    return dadd(dadd(dscale(f->t, s * cos(phi)), dscale(f->b, s * sin(phi))), dscale(f->n, c));
-}
-/* (cos theta, phi in [0, 2 pi)) of a direction in a frame. */
-static void dframe_coords(const dframe *f, dvec w, double *c, double *phi)
-{
-    *c = ddot(w, f->n);
-    double p = atan2(ddot(w, f->b), ddot(w, f->t));
-    *phi = p < 0.0 ? p + 2.0 * PI_D : p;
-}
-
-/* ---- chi-square --------------------------------------------------------- */
-
-/* Regularized upper incomplete gamma Q(a, x) (Numerical Recipes 6.2). */
-static double gamma_q(double a, double x)
-{
-    if (!(a > 0.0) || x < 0.0)
-        return NAN;
-    if (x == 0.0)
-        return 1.0;
-    double lpre = -x + a * log(x) - lgamma(a);
-    if (x < a + 1.0) {
-        double ap = a, del = 1.0 / a, sum = del;
-        for (int n = 0; n < 100000; n++) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if (fabs(del) < fabs(sum) * 1e-16)
-                break;
-        }
-        return fmax(0.0, 1.0 - sum * exp(lpre));
-    }
-    const double tiny = 1e-300;
-    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-    for (int i = 1; i < 100000; i++) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < tiny)
-            d = tiny;
-        c = b + an / c;
-        if (fabs(c) < tiny)
-            c = tiny;
-        d = 1.0 / d;
-        double del = d * c;
-        h *= del;
-        if (fabs(del - 1.0) < 1e-16)
-            break;
-    }
-    return exp(lpre) * h;
-}
-
-typedef struct chi2_result {
-    double stat, p;
-    int dof;
-    double zero_hits; /* samples in bins of expected count 0 */
-} chi2_result;
-
-static const double *sort_key;
-static int by_key(const void *a, const void *b)
-{
-    double x = sort_key[*(const int *)a], y = sort_key[*(const int *)b];
-    return x < y ? -1 : x > y;
-}
-
-/* Pearson's test; bins expecting fewer than min_exp are pooled into one
- * bin, itself merged into the smallest regular bin if still too small.
- * Bins where the quadrature found no mass at all are pooled too (a sliver
- * of the support may escape every quadrature node); zero_hits counts their
- * samples. Samples where the pdf really is 0 are caught one by one by the
- * consistency checks (sample pdf > 0 and equal to cdl_bsdf_pdf). */
-static chi2_result chi2_test(const double *obs, const double *expd, int n, double min_exp)
-{
-    chi2_result r = {0.0, 1.0, 0, 0.0};
-    int *idx = malloc(sizeof(int) * (size_t)n);
-    for (int i = 0; i < n; i++)
-        idx[i] = i;
-    sort_key = expd;
-    qsort(idx, (size_t)n, sizeof(int), by_key);
-    double po = 0.0, pe = 0.0;
-    int nb = 0;
-    for (int k = 0; k < n; k++) {
-        double o = obs[idx[k]], e = expd[idx[k]];
-        if (e <= 0.0)
-            r.zero_hits += o;
-        if (e < min_exp) {
-            po += o;
-            pe += e;
-            continue;
-        }
-        if ((pe > 0.0 || po > 0.0) && pe < min_exp) {
-            o += po;
-            e += pe;
-            po = pe = 0.0;
-        }
-        r.stat += (o - e) * (o - e) / e;
-        nb++;
-    }
-    if (pe > 0.0) {
-        r.stat += (po - pe) * (po - pe) / pe;
-        nb++;
-    } else if (po > 0.0) {
-        r.p = 0.0; /* samples and nowhere any expected mass */
-    }
-    free(idx);
-    r.dof = nb - 1;
-    chi2_count++;
-    if (r.p > 0.0)
-        r.p = r.dof >= 1 ? gamma_q(0.5 * r.dof, 0.5 * r.stat) : 1.0;
-    return r;
-}
-
-static void test_gamma(void)
-{
-    /* Q(1/2, x) = erfc(sqrt x), Q(1, x) = exp(-x), Q(5, x) = exp(-x) sum x^k/k!. */
-    double worst = 0.0;
-    for (double x = 0.01; x < 60.0; x *= 1.37) {
-        double e5 = 0.0, term = 1.0;
-        for (int k = 0; k < 5; k++) {
-            e5 += term;
-            term *= x / (k + 1);
-        }
-        e5 *= exp(-x);
-        double refs[3] = {erfc(sqrt(x)), exp(-x), e5}, as[3] = {0.5, 1.0, 5.0};
-        for (int i = 0; i < 3; i++) {
-            double q = gamma_q(as[i], x);
-            double err = fabs(q - refs[i]) / fmax(refs[i], 1e-300);
-            if (refs[i] > 1e-250 && err > worst)
-                worst = err;
-        }
-    }
-    check(worst < 1e-9, "gamma_q against closed forms: max relative error %.2e (< 1e-9)", worst);
-    double p = gamma_q(0.5, 3.841458820694124 / 2.0);
-    check(fabs(p - 0.05) < 1e-9, "chi2 p-value of 3.8415 with 1 dof: %.9f (0.05)", p);
-}
 
 /* ---- adaptive quadrature over (cos theta, phi) rectangles -------------- */
 
@@ -398,12 +204,6 @@ static dvec geo_normal(void) { return dnorm(dv(0.3, -0.5, 0.8)); }
 static dvec polar(const dframe *f, double theta, double phi)
 {
     return dframe_dir(f, cos(theta), phi);
-}
-
-static double rel_err(double a, double b)
-{
-    double d = fabs(a - b), m = fmax(fabs(a), fabs(b));
-    return m > 0.0 ? d / m : 0.0;
 }
 
 static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64_t stream)
@@ -1640,7 +1440,7 @@ static void test_microfacet(const mf_case *mc, double wo_deg, int tilted, uint64
 
 int main(void)
 {
-    test_gamma();
+    test_gamma(1);
     test_init();
 
     static const opaque_case cases[] = {

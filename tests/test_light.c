@@ -19,7 +19,6 @@
  * Deterministic seeds: the outcome never changes between runs. Returns 0
  * when every check passes. */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,161 +28,11 @@
 #include "core/vec.h"
 #include "scene/light.h"
 
-#define PI_D 3.14159265358979323846
-/* Significance of the chi-square tests: 1% for the whole program,
- * Sidak-corrected over its N_CHI2 tests. Seeds are fixed, so a run never
- * flakes; the correction keeps a correct implementation passing with
- * probability 0.99 even when another compiler or -march changes the float
- * bits and so the samples. Real defects give p-values of ~0. */
-#define FAMILY_ALPHA 0.01
+#include "test_stats.h"
+
+/* Chi-square tests in this program, for the Sidak correction of P_MIN
+ * (test_stats.h). */
 #define N_CHI2 5
-#define P_MIN (1.0 - pow(1.0 - FAMILY_ALPHA, 1.0 / N_CHI2))
-static int chi2_count;
-
-static int failures, checks;
-
-/* Prints "<message> ok" or "<message> FAIL" and counts failures. */
-static void check(int ok, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(ok ? " ok\n" : " FAIL\n");
-    checks++;
-    if (!ok)
-        failures++;
-}
-
-/* ---- double precision vectors ------------------------------------------ */
-
-typedef struct dvec {
-    double x, y, z;
-} dvec;
-
-static dvec dv(double x, double y, double z) { return (dvec){x, y, z}; }
-static dvec dadd(dvec a, dvec b) { return dv(a.x + b.x, a.y + b.y, a.z + b.z); }
-static dvec dsub(dvec a, dvec b) { return dv(a.x - b.x, a.y - b.y, a.z - b.z); }
-static dvec dscale(dvec a, double s) { return dv(a.x * s, a.y * s, a.z * s); }
-static double ddot(dvec a, dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dvec dcross(dvec a, dvec b)
-{
-    return dv(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-static double dlen(dvec a) { return sqrt(ddot(a, a)); }
-static dvec dnorm(dvec a) { return dscale(a, 1.0 / dlen(a)); }
-static dvec from_f(cdl_vec3 a) { return dv(a.x, a.y, a.z); }
-static cdl_vec3 to_f(dvec a) { return cdl_v3((float)a.x, (float)a.y, (float)a.z); }
-
-typedef struct dframe {
-    dvec t, b, n;
-} dframe;
-
-static dframe dframe_from(dvec n)
-{
-    dframe f;
-    f.n = n;
-    dvec a = fabs(n.x) < 0.7 ? dv(1, 0, 0) : dv(0, 1, 0);
-    f.t = dnorm(dsub(a, dscale(n, ddot(a, n))));
-    f.b = dcross(n, f.t);
-    return f;
-}
-
-static double rel_err(double a, double b)
-{
-    double d = fabs(a - b), m = fmax(fabs(a), fabs(b));
-    return m > 0.0 ? d / m : 0.0;
-}
-
-/* ---- chi-square --------------------------------------------------------- */
-
-/* Regularized upper incomplete gamma Q(a, x) (Numerical Recipes 6.2). */
-static double gamma_q(double a, double x)
-{
-    if (!(a > 0.0) || x < 0.0)
-        return NAN;
-    if (x == 0.0)
-        return 1.0;
-    double lpre = -x + a * log(x) - lgamma(a);
-    if (x < a + 1.0) {
-        double ap = a, del = 1.0 / a, sum = del;
-        for (int n = 0; n < 100000; n++) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if (fabs(del) < fabs(sum) * 1e-16)
-                break;
-        }
-        return fmax(0.0, 1.0 - sum * exp(lpre));
-    }
-    const double tiny = 1e-300;
-    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-    for (int i = 1; i < 100000; i++) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < tiny)
-            d = tiny;
-        c = b + an / c;
-        if (fabs(c) < tiny)
-            c = tiny;
-        d = 1.0 / d;
-        double del = d * c;
-        h *= del;
-        if (fabs(del - 1.0) < 1e-16)
-            break;
-    }
-    return exp(lpre) * h;
-}
-
-typedef struct chi2_result {
-    double stat, p;
-    int dof;
-    double zero_hits; /* samples in bins of expected count 0 */
-} chi2_result;
-
-/* Pearson's test. Bins of expected count 0 must stay empty (the p-value
- * is 0 otherwise); bins expecting fewer than min_exp are pooled. */
-static chi2_result chi2_test(const double *obs, const double *expd, int n, double min_exp)
-{
-    chi2_result r = {0.0, 1.0, 0, 0.0};
-    double po = 0.0, pe = 0.0;
-    int nb = 0;
-    for (int i = 0; i < n; i++) {
-        if (expd[i] <= 0.0) {
-            r.zero_hits += obs[i];
-        } else if (expd[i] < min_exp) {
-            po += obs[i];
-            pe += expd[i];
-        } else {
-            r.stat += (obs[i] - expd[i]) * (obs[i] - expd[i]) / expd[i];
-            nb++;
-        }
-    }
-    if (pe > 0.0) {
-        r.stat += (po - pe) * (po - pe) / pe;
-        nb++;
-    }
-    r.dof = nb - 1;
-    chi2_count++;
-    r.p = r.dof >= 1 ? gamma_q(0.5 * r.dof, 0.5 * r.stat) : 1.0;
-    if (r.zero_hits > 0.0)
-        r.p = 0.0;
-    return r;
-}
-
-static void test_gamma(void)
-{
-    double worst = 0.0;
-    for (double x = 0.01; x < 60.0; x *= 1.37) {
-        double refs[2] = {erfc(sqrt(x)), exp(-x)}, as[2] = {0.5, 1.0};
-        for (int i = 0; i < 2; i++)
-            if (refs[i] > 1e-250)
-                worst = fmax(worst, rel_err(gamma_q(as[i], x), refs[i]));
-    }
-    check(worst < 1e-9, "gamma_q against erfc(sqrt x) and exp(-x): max relative error %.2e (< 1e-9)",
-          worst);
-}
 
 /* cdl_light_pdf_li of the light point p seen from ref, whichever of its
  * two signatures scene/light.h declares: (l, ref, p), or (l, ref, wi,
@@ -784,7 +633,7 @@ static void test_alias(void)
 
 int main(void)
 {
-    test_gamma();
+    test_gamma(0);
     test_triangle();
     test_point();
     test_alias();
