@@ -2,6 +2,7 @@
  * the sample or time budget is met (or Ctrl-C), write the images. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <float.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
@@ -300,6 +301,28 @@ static int frame_scene(const cdl_scene *s, double fov, int w, int h, cdl_camera 
     return cdl_camera_init(cam, eye, c, cdl_v3(0.0f, 1.0f, 0.0f), (float)fov, w, h, err);
 }
 
+/* Kollig & Keller's Figure 4 colours: green at the smallest value of the
+ * layer, red at the largest (written linear, so the PNG shows them). */
+static void false_colour(cdl_image *img)
+{
+    size_t n = (size_t)img->width * (size_t)img->height;
+    float lo = FLT_MAX, hi = -FLT_MAX;
+    for (size_t i = 0; i < n; i++) {
+        float v = img->rgb[3 * i];
+        if (v > 0.0f) {
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        float v = img->rgb[3 * i];
+        float t = v > 0.0f && hi > lo ? (v - lo) / (hi - lo) : 0.0f;
+        img->rgb[3 * i] = v > 0.0f ? t : 0.0f;
+        img->rgb[3 * i + 1] = v > 0.0f ? 1.0f - t : 0.0f;
+        img->rgb[3 * i + 2] = 0.0f;
+    }
+}
+
 static void default_output(const char *scene, const cdl_scene_settings *set, char *buf, size_t n)
 {
     if (set->filename[0] && (cdl_image_has_ext(set->filename, ".exr") ||
@@ -439,10 +462,19 @@ int cdl_cmd_render(int argc, char **argv)
         layers[i] = (cdl_layer){film.aovs[i].name, &aov_img[i], film.aovs[i].channels == 1};
         nl = i + 1;
     }
-    for (int i = 0; !rc && i < a.nout; i++)
+    for (int i = 0; !rc && i < a.nout; i++) {
         rc = nl && cdl_image_has_ext(a.out[i], ".exr")
                  ? cdl_image_write_layers(a.out[i], &img, layers, nl, meta, 5, &err)
                  : cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
+        /* a PNG output also gets one PNG per layer: OUT.png -> OUT.NAME.png */
+        for (int l = 0; !rc && l < nl && cdl_image_has_ext(a.out[i], ".png"); l++) {
+            char path[1100];
+            snprintf(path, sizeof path, "%.*s.%s.png", (int)(strlen(a.out[i]) - 4), a.out[i], layers[l].name);
+            if (layers[l].grey)
+                false_colour(&aov_img[l]);
+            rc = cdl_image_write(path, &aov_img[l], meta, 5, layers[l].grey ? 0.0f : (float)a.exposure, &err);
+        }
+    }
     for (int i = 0; i < nl; i++)
         cdl_image_free(&aov_img[i]);
     int status = rc ? cdl_report(&err) : 0;
