@@ -62,7 +62,6 @@ class Scene:
         self.light_panels = 0
         self.light_area = 0.0
         self.camera = None
-        self.note = ""
 
     # --- materials ------------------------------------------------------------
     def material(self, name, kd=(0.5, 0.5, 0.5), ks=None, ns=None, ke=None, illum=None,
@@ -233,28 +232,30 @@ class Scene:
             b, c, nb, nc = c, b, nc, nb
         self.tri(a, b, c, mtl, na, nb, nc)
 
-    def ring(self, cx, cz, r_in, r_out, h, mtl, n=96):
-        """A closed thick ring (tube wall) standing on y = 0, with vertex normals."""
+    def ring(self, cx, cz, r_in, r_out, h, mtl, outer_mtl=None, n=96):
+        """A closed thick ring (tube wall) standing on y = 0, with vertex normals; the
+        inner wall is made of mtl, the outer wall and the rims of outer_mtl."""
+        outer_mtl = outer_mtl or mtl
         up, down = (0, 1, 0), (0, -1, 0)
-        for i in range(n):
-            a0, a1 = 2 * math.pi * i / n, 2 * math.pi * (i + 1) / n
-            d0 = (math.cos(a0), 0, math.sin(a0))
-            d1 = (math.cos(a1), 0, math.sin(a1))
 
-            def p(d, r, y):
-                return (cx + r * d[0], y, cz + r * d[2])
-            neg0, neg1 = (-d0[0], 0, -d0[2]), (-d1[0], 0, -d1[2])
-            # outer wall, normal outwards
-            self._quad_n(p(d0, r_out, 0), p(d1, r_out, 0), p(d1, r_out, h), p(d0, r_out, h),
-                         d0, d1, d1, d0, mtl, d0)
-            # inner wall, normal towards the axis
-            self._quad_n(p(d0, r_in, 0), p(d1, r_in, 0), p(d1, r_in, h), p(d0, r_in, h),
-                         neg0, neg1, neg1, neg0, mtl, neg0)
-            # top and bottom annuli
-            self._quad_n(p(d0, r_in, h), p(d1, r_in, h), p(d1, r_out, h), p(d0, r_out, h),
-                         up, up, up, up, mtl, up)
-            self._quad_n(p(d0, r_in, 0), p(d1, r_in, 0), p(d1, r_out, 0), p(d0, r_out, 0),
-                         down, down, down, down, mtl, down)
+        def p(d, r, y):
+            return (cx + r * d[0], y, cz + r * d[2])
+        for part in ("inner", "outer", "top", "bottom"):
+            for i in range(n):
+                a0, a1 = 2 * math.pi * i / n, 2 * math.pi * (i + 1) / n
+                d0 = (math.cos(a0), 0, math.sin(a0))
+                d1 = (math.cos(a1), 0, math.sin(a1))
+                neg0, neg1 = (-d0[0], 0, -d0[2]), (-d1[0], 0, -d1[2])
+                if part == "inner":     # normal towards the axis
+                    self._quad_n(p(d0, r_in, 0), p(d1, r_in, 0), p(d1, r_in, h),
+                                 p(d0, r_in, h), neg0, neg1, neg1, neg0, mtl, neg0)
+                elif part == "outer":   # normal outwards
+                    self._quad_n(p(d0, r_out, 0), p(d1, r_out, 0), p(d1, r_out, h),
+                                 p(d0, r_out, h), d0, d1, d1, d0, outer_mtl, d0)
+                else:
+                    y, nn = (h, up) if part == "top" else (0, down)
+                    self._quad_n(p(d0, r_in, y), p(d1, r_in, y), p(d1, r_out, y),
+                                 p(d0, r_out, y), nn, nn, nn, nn, outer_mtl, nn)
 
     def _quad_n(self, a, b, c, d, na, nb, nc, nd, mtl, normal):
         n = _cross(_sub(b, a), _sub(c, a))
@@ -376,7 +377,7 @@ def office():
     W, D, H, T = 6.0, 4.0, 3.0, 0.2
     white = s.material("wall_white", kd=(0.72, 0.71, 0.68))
     blue = s.material("wall_blue", kd=(0.22, 0.33, 0.55))
-    terra = s.material("wall_terracotta", kd=(0.66, 0.33, 0.22))
+    terra = s.material("wall_terracotta", kd=(0.60, 0.38, 0.28))
     floor = s.material("carpet", kd=(0.30, 0.30, 0.33))
     ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
     wood = s.material("wood", kd=(0.50, 0.34, 0.20), ks=(0.04, 0.04, 0.04), ns=60)
@@ -388,9 +389,9 @@ def office():
     books = [s.material("book_%d" % i, kd=c) for i, c in enumerate(
         [(0.6, 0.1, 0.1), (0.1, 0.2, 0.5), (0.7, 0.6, 0.3), (0.15, 0.4, 0.15),
          (0.75, 0.75, 0.7), (0.3, 0.15, 0.3)])]
-    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(12, 12, 12))
-    # west wall (x = 0) blue, north wall (z = D) terracotta, the rest white
-    s.shell(0, W, 0, D, H, T, white, floor, ceil, {"-x": blue, "+z": terra})
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(15, 15, 15))
+    # west wall (x = 0) blue, south wall (z = 0) terracotta, the rest white
+    s.shell(0, W, 0, D, H, T, white, floor, ceil, {"-x": blue, "-z": terra})
 
     # lit half: x < 3; three panels over it
     s.group("lights")
@@ -404,31 +405,27 @@ def office():
     s.group("desks")
     desk(s, 0.5, 0.15, 1.6, 0.8, wood, metal)     # lit half, against the south wall
     desk(s, 0.9, 3.05, 1.6, 0.8, wood, metal)     # lit half, against the north wall
-    desk(s, 4.0, 0.15, 1.6, 0.8, wood, metal)     # dark half
+    desk(s, 4.3, 0.15, 1.6, 0.8, wood, metal)     # dark half
     s.group("monitors")
-    for (mx, mz) in ((1.3, 0.35), (4.8, 0.35)):
+    for (mx, mz) in ((1.3, 0.35), (5.1, 0.35)):
         s.box((mx - 0.28, 0.85, mz), (mx + 0.28, 1.2, mz + 0.03), black)
         s.box((mx - 0.03, 0.75, mz), (mx + 0.03, 0.85, mz + 0.06), metal)
         s.box((mx - 0.12, 0.75, mz - 0.05), (mx + 0.12, 0.76, mz + 0.12), metal)
     s.group("chairs")
     chair(s, 1.3, 1.35, navy, metal, facing=0)
     chair(s, 1.7, 2.75, red, metal, facing=180)
-    chair(s, 4.8, 1.4, navy, metal, facing=-10)
+    chair(s, 5.1, 1.4, navy, metal, facing=-10)
     chair(s, 5.0, 2.6, red, metal, facing=60)
-    s.group("shelves")
-    shelf(s, 0.0, 1.45, 1.2, 0.35, 2.0, wood, books, seed=1, along="z")  # on the west wall
-    s.group("shelves_dark")
-    # against the east wall; rotated: books face -x
+    s.group("shelves")   # against the south wall, either side of the partition
+    shelf(s, 2.2, 0.0, 0.85, 0.35, 2.0, wood, books, seed=1)
+    shelf(s, 3.3, 0.0, 0.9, 0.35, 2.2, wood, books, seed=3)
+    s.group("shelves_east")   # against the east wall, books facing -x
     s.box((5.55, 0, 1.3), (6.0, 1.0, 2.5), wood)                           # low cabinet
     shelf(s, 5.6, 2.6, 1.2, 0.4, 2.2, wood, books, seed=2, along="z", flip=True)
     s.group("table")
     s.box((3.6, 0.70, 3.0), (4.6, 0.74, 3.8), wood)
     s.box((4.05, 0, 3.35), (4.15, 0.70, 3.45), metal)
     s.camera = ((3.0, 1.9, 3.85), (3.0, 0.8, 0.0), 60)
-    s.note = ("Office-like interior, %g x %g x %g m, stand-in for Kollig & Keller 2004 Fig. 6 "
-              "'office'. Three ceiling panels (1.2 x 0.6 m, Ke 12) over the west half (x < 3); "
-              "a 1.7 m partition screen at x = 3.2 shades the east half, which is lit mostly "
-              "indirectly. Blue west wall, terracotta north wall.") % (W, D, H)
     return s
 
 
@@ -444,7 +441,7 @@ def conference():
     metal = s.material("metal", kd=(0.25, 0.25, 0.27), ks=(0.30, 0.30, 0.30), ns=80)
     seat = s.material("fabric_black", kd=(0.06, 0.06, 0.07))
     board = s.material("whiteboard", kd=(0.78, 0.78, 0.78), ks=(0.1, 0.1, 0.1), ns=300)
-    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(14, 14, 14))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(20, 20, 20))
 
     s.group("floor")
     s.box((-T, -T, -T), (W + T, 0, D + T), floor)
@@ -474,24 +471,16 @@ def conference():
         s.box((lx, 0, 2.6), (lx + 0.1, 0.71, 3.4), metal)
     s.box((2.6, 0.55, 2.95), (7.4, 0.65, 3.05), metal)
     s.group("chairs")
-    n = 0
     for cx in (2.8, 3.9, 5.0, 6.1, 7.2):
         chair(s, cx, tz0 - 0.45, seat, metal, facing=180)
         chair(s, cx, tz1 + 0.45, seat, metal, facing=0)
-        n += 2
     chair(s, tx0 - 0.45, 3.0, seat, metal, facing=-90)
     chair(s, tx1 + 0.45, 3.0, seat, metal, facing=90)
-    n += 2
     s.group("whiteboard")
     s.box((0, 0.9, 1.5), (0.03, 2.1, 4.5), board)
     s.group("sideboard")
     s.box((6.0, 0, 5.5), (9.0, 0.9, 6.0), wood)
     s.camera = ((9.6, 2.1, 5.0), (2.5, 0.5, 1.8), 60)
-    s.note = ("Conference-room-like interior, %g x %g x %g m, stand-in for Kollig & Keller "
-              "2004 'conference room'. A 6 x 1.4 m table with %d chairs, six 0.6 x 0.6 m "
-              "ceiling panels (Ke 14) over the table, a door recessed 0.12 m into the south "
-              "wall, a whiteboard on the west wall, a blue-grey east wall. The floor under the "
-              "table is lit only indirectly.") % (W, D, H, n)
     return s
 
 
@@ -505,7 +494,7 @@ def rooms10x10():
     wood = s.material("wood", kd=(0.50, 0.34, 0.20))
     cols = [s.material("box_%d" % i, kd=c) for i, c in enumerate(
         [(0.6, 0.15, 0.1), (0.15, 0.45, 0.15), (0.15, 0.2, 0.55), (0.7, 0.6, 0.2)])]
-    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(16, 16, 16))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(20, 20, 20))
     L = N * P   # wall centre lines at 0, P, ..., N P; room interiors 4.0 m square
     s.group("floor")
     s.box((-T / 2, -T, -T / 2), (L + T / 2, 0, L + T / 2), floor)
@@ -534,7 +523,7 @@ def rooms10x10():
     s.group("lights")
     for j in range(N):
         for i in range(N):
-            s.light((i + 0.5) * P, (j + 0.5) * P, 0.6, 0.6, H - 0.01, lamp)
+            s.light((i + 0.5) * P, (j + 0.5) * P, 0.8, 0.8, H - 0.01, lamp)
     s.group("furniture")
     rng = random.Random(10)
     for j in range(N):
@@ -555,12 +544,6 @@ def rooms10x10():
     # two doors leading to rooms (4, 5) and (5, 4)
     x0, z0 = 4 * P + T / 2, 4 * P + T / 2
     s.camera = ((x0 + 0.3, 1.6, z0 + 0.3), (x0 + 3.3, 1.1, z0 + 3.4), 60)
-    s.note = ("%d x %d rooms of 4 x 4 x %g m on a %g m grid (walls %g m thick), each interior "
-              "wall with a 1 x %g m door gap near one end or the other (alternating), one 0.6 "
-              "x 0.6 m ceiling panel (Ke 16) per room, a table and a cabinet per room. "
-              "Stand-in for Keller & Wald 2000 Figs. 1-2. The camera is in room (4, 4) "
-              "(x, z in [16.9, 20.9]) looking at its doors to rooms (5, 4) and (4, 5).") % (
-        N, N, H, P, T, H_DOOR)
     return s
 
 
@@ -573,7 +556,7 @@ def doorslit():
     door_m = s.material("wood_door", kd=(0.60, 0.45, 0.30))
     red = s.material("fabric_red", kd=(0.55, 0.08, 0.07))
     blue = s.material("wall_blue", kd=(0.25, 0.35, 0.60))
-    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(20, 20, 20))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(250, 250, 250))
     X1 = W + T          # right room interior x in [X1, X1 + W]
     # both rooms in one shell, split by the shared wall at x in [W, W + T]
     s.shell(0, X1 + W, 0, D, H, T, white, floor, ceil, {"+x": blue})
@@ -581,42 +564,33 @@ def doorslit():
     z0, z1 = 1.5, 2.4   # door opening
     s.wall("z", W + T / 2, -T / 2, D + T / 2, T, white, doors=[(z0, z1)], y1=H + 0.1)
     # The door (0.9 x 0.04 m) is hinged at z0 on the wall's centre line and opened
-    # into the left room by the angle that leaves a 5 cm gap between its free edge
-    # and the frame.
+    # into the left room by the angle that leaves a straight slit 5 cm wide (seen
+    # along x) between its free edge and the frame.
     s.group("door")
-    hx, dt, dw, gap = W + T / 2, 0.04, z1 - z0, 0.05
+    hx, dt, dw, gap = W + T / 2, 0.04, z1 - z0 - 0.003, 0.05
 
-    def free_corner(a):  # right (+x) face corner of the free edge, door opened by a
-        ca, sa = math.cos(a), math.sin(a)
-        return (hx + dt / 2 * ca - dw * sa, z0 + dt / 2 * sa + dw * ca)
-    lo_a, hi_a = 0.0, 0.5
+    def slit(a):  # z1 minus the largest z of the door (its +x face's free corner)
+        return z1 - (z0 + dt / 2 * math.sin(a) + dw * math.cos(a))
+    lo_a, hi_a = 0.0, 0.8
     for _ in range(60):
         mid = (lo_a + hi_a) / 2
-        fx, fz = free_corner(mid)
-        if math.hypot(W - fx, z1 - fz) < gap:
+        if slit(mid) < gap:
             lo_a = mid
         else:
             hi_a = mid
-    ang = math.degrees(lo_a)
+    ang = math.degrees(hi_a)
     # box in the closed position (centred on x = hx, z from z0 - 0.03 into the
     # frame to z1 - 0.003), then turned about the hinge by -ang (clockwise seen from
     # above), which moves the free edge (+z) towards -x.
     s.box((hx - dt / 2, -0.02, z0 - 0.03), (hx + dt / 2, H_DOOR + 0.01, z1 - 0.003), door_m,
           rot=(-ang, (hx, z0)))
     s.group("light")
-    s.light(W / 2, D / 2, 1.0, 1.0, H - 0.01, lamp)
+    s.light(W / 2, D / 2, 2.0, 2.0, H - 0.01, lamp)
     s.group("furniture")
     chair(s, 1.2, 1.2, red, door_m, facing=30)
     s.box((X1 + 2.6, 0, 2.8), (X1 + 3.8, 0.75, 3.8), door_m)   # a crate in the right room
     s.box((X1 + 0.8, 0, 0.4), (X1 + 1.3, 0.5, 0.9), red)
     s.camera = ((X1 + W - 0.3, 1.5, D - 0.3), (W + T, 1.0, 1.6), 60)
-    s.note = ("Two rooms of %g x %g x %g m side by side (x in [0, 4] and [4.2, 8.2]); the "
-              "shared wall has a 0.9 x 2.1 m door opening at z in [1.5, 2.4] whose door is "
-              "opened %.1f degrees into the left room, leaving a 5 cm gap between its free "
-              "edge and the frame. The only light, a 1 x 1 m panel (Ke 20), is in the left "
-              "room; the camera is in the right room looking at the shared wall, so everything "
-              "it sees is lit through the slit. Stand-in for Keller & Wald 2000 Fig. 4.") % (
-        W, D, H, ang)
     return s
 
 
@@ -696,61 +670,52 @@ def floor_many_lights():
     s.group("furniture")
     rng = random.Random(5)
     for (x0, x1, z0, z1, dz, d) in offices:
-        # a desk against the outer (non-door) wall, a chair, a cabinet in a corner
-        back = z0 + T / 2 if dz == z1 else z1 - T / 2   # inner face of the wall opposite the door
-        w = 1.6
-        dx = x0 + T / 2 + rng.uniform(0.4, (x1 - x0) - T - w - 0.7)
-        if back < dz:
-            desk(s, dx, back + 0.05, w, 0.8, wood, metal)
-            chair(s, dx + w / 2, back + 1.3, seat, metal, facing=rng.uniform(-30, 30))
+        # a desk against the side wall next to the door, in the back half of the
+        # office, with its chair; a cabinet against the other side wall
+        inner0, inner1 = x0 + T / 2, x1 - T / 2
+        back = z0 + T / 2 if dz == z1 else z1 - T / 2   # inner face of the back wall
+        sgn = 1 if back < dz else -1                      # from the back wall inwards
+        door_low = d[0] - x0 < x1 - d[1]                  # door near x0?
+        dl = 1.6                                          # desk length along z
+        za = back + sgn * rng.uniform(0.15, 0.35)
+        zb = za + sgn * dl
+        dz0, dz1 = min(za, zb), max(za, zb)
+        zc = (dz0 + dz1) / 2 + rng.uniform(-0.3, 0.3)
+        if door_low:
+            desk(s, inner0 + 0.02, dz0, 0.8, dl, wood, metal)
+            chair(s, inner0 + 1.2, zc, seat, metal, facing=90 + rng.uniform(-30, 30))  # faces -x
+            cx0 = inner1 - 0.46
         else:
-            desk(s, dx, back - 0.85, w, 0.8, wood, metal)
-            chair(s, dx + w / 2, back - 1.3, seat, metal, facing=180 + rng.uniform(-30, 30))
-        # a cabinet against the side wall away from the door, half way between the
-        # door wall and the back wall
-        zm = (z0 + z1) / 2
-        if d[0] - x0 < x1 - d[1]:
-            cx0 = x1 - T / 2 - 0.46
-        else:
-            cx0 = x0 + T / 2 + 0.01
+            desk(s, inner1 - 0.82, dz0, 0.8, dl, wood, metal)
+            chair(s, inner1 - 1.2, zc, seat, metal, facing=-90 + rng.uniform(-30, 30))
+            cx0 = inner0 + 0.01
+        zm = (z0 + z1) / 2 + rng.uniform(-0.4, 0.4)
         s.box((cx0, 0, zm - 0.4), (cx0 + 0.45, rng.uniform(1.0, 2.0), zm + 0.4),
               cols[rng.randrange(len(cols))])
     # camera in the south office at x in [15, 20], from its south-west corner towards
     # its door (x in [18.4, 19.4]) onto corridor A
-    s.camera = ((15.4, 1.7, 0.45), (18.9, 1.1, 5.5), 60)
-    s.note = ("A building floor of %g x %g x %g m: %d offices in four rows (two rows of "
-              "5 x 5 m, two back-to-back rows of 4.75 x 3 m split by a cross corridor), two "
-              "2 m corridors along x joined by the cross corridor; 1 x %g m door gaps. 4 "
-              "ceiling panels (0.6 x 0.6 m, Ke 10) per office, one every 4 m in the "
-              "corridors. Each office has a desk, a chair and a cabinet. Stand-in for Keller & "
-              "Wald 2000 Fig. 5 and Bekaert et al. 2003 Fig. 6. The camera is in the south "
-              "office at x in [15, 20] looking at its door onto corridor A.") % (
-        W, D, H, len(offices), H_DOOR)
+    s.camera = ((15.3, 1.7, 0.3), (19.5, 0.8, 3.3), 60)
     return s
 
 
 def caustic_ring():
     s = Scene("caustic_ring")
-    R, H, T = 2.0, 2.5, 0.2       # room x, z in [-R, R], height H
+    R, H, T = 3.0, 2.0, 0.2       # room x, z in [-R, R], height H
     wall = s.material("wall_grey", kd=(0.55, 0.55, 0.55))
     floor = s.material("floor", kd=(0.70, 0.68, 0.64))
     ceil = s.material("ceiling", kd=(0.70, 0.70, 0.70))
     mirror = s.material("mirror", kd=(0, 0, 0), ks=(0.95, 0.93, 0.88), illum=5)
     glass = s.material("glass", kd=(0, 0, 0), ks=(1, 1, 1), ni=1.5, illum=7)
-    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(60, 60, 60))
+    ring_out = s.material("ring_outside", kd=(0.25, 0.25, 0.27), ks=(0.3, 0.3, 0.3), ns=60)
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(200, 200, 200))
     s.shell(-R, R, -R, R, H, T, wall, floor, ceil)
     s.group("light")
-    s.light(-1.5, -0.6, 0.25, 0.25, H - 0.01, lamp)
+    s.light(-2.6, -1.4, 0.3, 0.3, H - 0.01, lamp)   # seen from the ring at ~30 degrees
     s.group("ring")
-    s.ring(0.35, 0.25, 0.40, 0.41, 0.22, mirror)
+    s.ring(0.4, 0.2, 0.45, 0.47, 0.4, mirror, ring_out)
     s.group("sphere")
-    s.sphere((-0.55, 0.3, 0.55), 0.3, glass)
-    s.camera = ((1.5, 1.7, 1.9), (-0.1, 0.1, 0.2), 50)
-    s.note = ("A closed 4 x 4 x %g m room with a diffuse floor, a mirror ring (illum 5, "
-              "radius 0.4 m, 0.22 m high, smooth vertex normals) and a glass sphere (illum 7, "
-              "Ni 1.5, radius 0.3 m, smooth vertex normals); one small 0.25 x 0.25 m ceiling "
-              "panel (Ke 60) off to the side casts a cardioid caustic inside the ring and a "
-              "focused caustic behind the sphere.") % H
+    s.sphere((-0.5, 0.3, -0.8), 0.3, glass)
+    s.camera = ((0.0, 1.9, 1.6), (0.2, 0.0, -0.2), 55)
     return s
 
 
