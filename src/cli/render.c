@@ -50,7 +50,9 @@ static void render_help(void)
 {
     printf("usage: candela render SCENE [options]\n"
            "\n"
-           "SCENE is a Wavefront OBJ file (materials from its MTL files).\n"
+           "SCENE is a Wavefront OBJ file (materials from its MTL files) or a pbrt-v3/v4\n"
+           "scene file (.pbrt), whose camera, film, sampler and integrator settings apply\n"
+           "unless the options below override them.\n"
            "\n"
            "  -i, --integrator NAME   light transport method (default path)\n"
            "  -o, --output FILE       .exr (32-bit float), .png (sRGB) or .pfm; repeatable\n"
