@@ -1,5 +1,5 @@
-/* Shared helpers of the statistical tests: the BSDF tests (test_bsdf.c) and
- * the light tests (test_light.c) both include this header.
+/* Shared helpers of the statistical tests: the BSDF tests (test_bsdf.c,
+ * test_microfacet.c) and the light tests (test_light.c) include this header.
  *
  *  - check(): prints "<message> ok" / "<message> FAIL", counts checks and
  *    failures;
@@ -8,7 +8,11 @@
  *  - rel_err();
  *  - the chi-square test: regularized incomplete gamma gamma_q, Pearson's
  *    test chi2_test with pooling of low-expected bins, the Sidak-corrected
- *    threshold P_MIN, and test_gamma, the self-test of gamma_q.
+ *    threshold P_MIN, and test_gamma, the self-test of gamma_q;
+ *  - for the BSDF tests: adaptive Gauss-Legendre quadrature of pdf and
+ *    f |cos| over (cos theta, phi) rectangles (integrate_cell), the sphere
+ *    binning NC x NP, the common geometric normal and the angle-form
+ *    dielectric Fresnel reference.
  *
  * Everything is static (one copy per test program) and marked unused, so
  * -Wall -Wextra stays quiet in a file that uses only some of it. An
@@ -24,6 +28,7 @@
 #include <stdlib.h>
 
 #include "core/vec.h"
+#include "scene/bsdf.h"
 
 #define TS_UNUSED __attribute__((unused))
 
@@ -250,6 +255,163 @@ static TS_UNUSED void test_gamma(int full)
     check(worst < 1e-9, "gamma_q against closed forms: max relative error %.2e (< 1e-9)", worst);
     double p = gamma_q(0.5, 3.841458820694124 / 2.0);
     check(fabs(p - 0.05) < 1e-9, "chi2 p-value of 3.8415 with 1 dof: %.9f (0.05)", p);
+}
+
+/* ---- BSDF test machinery (test_bsdf.c, test_microfacet.c) ------------- */
+
+#define DEG (PI_D / 180.0)
+
+/* Binning of the sphere for the chi-square tests, and tolerances shared by
+ * the opaque and microfacet tests. */
+#define NC 10 /* cos theta bins over [-1, 1] */
+#define NP 20 /* phi bins */
+#define ZERO_HITS_MAX 20 /* slivers of support between quadrature nodes */
+#define COS_ABS_ERR 1e-6 /* float rounding of cos(wi, n) after a change of frame */
+
+/* ---- adaptive quadrature over (cos theta, phi) rectangles -------------- */
+
+/* Integrand: [0] = pdf(wo, wi), [1] = f(wo, wi).x |cos(wi, shading n)|
+ * (transport mode adj1), [2] the same for a second BSDF b2 (mode adj2),
+ * [3] for a third b3 (mode adj2). */
+#define NQ 4
+typedef struct integ {
+    const cdl_bsdf *b;
+    cdl_vec3 wo;
+    dframe fr;       /* frame of the (cos theta, phi) coordinates */
+    int has_lobe;    /* force refinement around a narrow lobe */
+    dvec lobe;
+    double sigma;    /* angular width of the lobe */
+    int albedo;      /* also integrate f |cos| */
+    long evals;
+    int adj1, adj2;
+    const cdl_bsdf *b2, *b3; /* or NULL */
+    double tol_abs, tol_rel; /* 0: TOL_ABS, TOL_REL */
+} integ;
+
+#define TOL_ABS 3e-8
+#define TOL_REL 1e-5
+#define MAX_DEPTH 8
+#define MIN_DEPTH 1 /* every bin gets at least 4x4 cells of 4x4 nodes */
+
+static TS_UNUSED const double gl_x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                               0.8611363115940526};
+static TS_UNUSED const double gl_w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
+                               0.3478548451374538};
+
+static TS_UNUSED void integrand(integ *g, double c, double phi, double out[NQ])
+{
+    cdl_vec3 wi = to_f(dframe_dir(&g->fr, c, phi));
+    g->evals++;
+    out[0] = cdl_bsdf_pdf(g->b, g->wo, wi);
+    out[1] = out[2] = out[3] = 0.0;
+    if (g->albedo) {
+        cdl_vec3 f = cdl_bsdf_eval(g->b, g->wo, wi, g->adj1);
+        out[1] = f.x * fabs(cdl_dot(wi, g->b->frame.n));
+        if (g->b2) {
+            f = cdl_bsdf_eval(g->b2, g->wo, wi, g->adj2);
+            out[2] = f.x * fabs(cdl_dot(wi, g->b2->frame.n));
+        }
+        if (g->b3) {
+            f = cdl_bsdf_eval(g->b3, g->wo, wi, g->adj2);
+            out[3] = f.x * fabs(cdl_dot(wi, g->b3->frame.n));
+        }
+    }
+}
+
+static TS_UNUSED void gl_cell(integ *g, double c0, double c1, double p0, double p1, double out[NQ])
+{
+    double cm = 0.5 * (c0 + c1), ch = 0.5 * (c1 - c0), pm = 0.5 * (p0 + p1), ph = 0.5 * (p1 - p0);
+    for (int k = 0; k < NQ; k++)
+        out[k] = 0.0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double v[NQ];
+            integrand(g, cm + ch * gl_x[i], pm + ph * gl_x[j], v);
+            for (int k = 0; k < NQ; k++)
+                out[k] += gl_w[i] * gl_w[j] * v[k];
+        }
+    for (int k = 0; k < NQ; k++)
+        out[k] *= ch * ph;
+}
+
+/* Whether a cell is too coarse for the lobe: angular radius above half the
+ * lobe width and the lobe axis within a few widths of the cell. */
+static TS_UNUSED int near_lobe(const integ *g, double c0, double c1, double p0, double p1)
+{
+    if (!g->has_lobe)
+        return 0;
+    double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
+    dvec ctr = dframe_dir(&g->fr, cm, pm);
+    double cs[2] = {c0, c1}, ps[3] = {p0, pm, p1}, rad = 0.0;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 3; j++)
+            rad = fmax(rad, dangle(ctr, dframe_dir(&g->fr, cs[i], ps[j])));
+    return rad > 0.5 * g->sigma && dangle(ctr, g->lobe) < rad + 6.0 * g->sigma;
+}
+
+static TS_UNUSED void adapt(integ *g, double c0, double c1, double p0, double p1, const double whole[NQ],
+                  int depth, double acc[NQ])
+{
+    double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
+    double q[4][NQ], sum[NQ] = {0.0};
+    double cc[4][2] = {{c0, cm}, {c0, cm}, {cm, c1}, {cm, c1}};
+    double pp[4][2] = {{p0, pm}, {pm, p1}, {p0, pm}, {pm, p1}};
+    for (int k = 0; k < 4; k++) {
+        gl_cell(g, cc[k][0], cc[k][1], pp[k][0], pp[k][1], q[k]);
+        for (int i = 0; i < NQ; i++)
+            sum[i] += q[k][i];
+    }
+    int done = depth >= MAX_DEPTH;
+    if (!done && depth >= MIN_DEPTH) {
+        done = 1;
+        double ta = g->tol_abs > 0.0 ? g->tol_abs : TOL_ABS, tr = g->tol_rel > 0.0 ? g->tol_rel : TOL_REL;
+        for (int i = 0; i < NQ; i++)
+            if (fabs(sum[i] - whole[i]) > fmax(ta, tr * fabs(sum[i])))
+                done = 0;
+        if (done && near_lobe(g, c0, c1, p0, p1))
+            done = 0;
+    }
+    if (done) {
+        for (int i = 0; i < NQ; i++)
+            acc[i] += sum[i];
+        return;
+    }
+    for (int k = 0; k < 4; k++)
+        adapt(g, cc[k][0], cc[k][1], pp[k][0], pp[k][1], q[k], depth + 1, acc);
+}
+
+static TS_UNUSED void integrate_cell(integ *g, double c0, double c1, double p0, double p1, double out[NQ])
+{
+    double whole[NQ];
+    gl_cell(g, c0, c1, p0, p1, whole);
+    for (int i = 0; i < NQ; i++)
+        out[i] = 0.0;
+    adapt(g, c0, c1, p0, p1, whole, 0, out);
+}
+
+/* The geometric normal of every test: deliberately not axis aligned. */
+static TS_UNUSED dvec geo_normal(void) { return dnorm(dv(0.3, -0.5, 0.8)); }
+
+/* Direction at polar angle theta from n, azimuth phi (in n's frame). */
+static TS_UNUSED dvec polar(const dframe *f, double theta, double phi)
+{
+    return dframe_dir(f, cos(theta), phi);
+}
+
+/* Fresnel for unpolarized light in the angle form (independent of the
+ * library's): rs = -sin(ti - tt) / sin(ti + tt), rp = tan(ti - tt) / tan(ti + tt). */
+static TS_UNUSED double fresnel_ref(double ti, double eta_i, double eta_t)
+{
+    double st = eta_i / eta_t * sin(ti);
+    if (st >= 1.0)
+        return 1.0;
+    double tt = asin(st);
+    if (ti < 1e-9) {
+        double r = (eta_i - eta_t) / (eta_i + eta_t);
+        return r * r;
+    }
+    double rs = sin(ti - tt) / sin(ti + tt), rp = tan(ti - tt) / tan(ti + tt);
+    return 0.5 * (rs * rs + rp * rp);
 }
 
 #endif
