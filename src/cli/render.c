@@ -477,6 +477,18 @@ int cdl_cmd_render(int argc, char **argv)
             rc = cdl_image_write(path, &aov_img[l], meta, 5, layers[l].grey ? 0.0f : (float)a.exposure, &err);
         }
     }
+    for (int i = 0; !rc && i < nl; i++) {
+        /* statistics of one-channel layers (e.g. the eye path length) */
+        if (!layers[i].grey)
+            continue;
+        double sum = 0.0, mx = 0.0;
+        size_t n = (size_t)img.width * (size_t)img.height;
+        for (size_t k = 0; k < n; k++) {
+            sum += aov_img[i].rgb[3 * k];
+            mx = aov_img[i].rgb[3 * k] > mx ? aov_img[i].rgb[3 * k] : mx;
+        }
+        printf("%s: mean %.4f, max %.4f per pixel\n", layers[i].name, sum / (double)n, mx);
+    }
     for (int i = 0; i < nl; i++)
         cdl_image_free(&aov_img[i]);
     int status = rc ? cdl_report(&err) : 0;
