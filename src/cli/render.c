@@ -72,7 +72,8 @@ static void render_help(void)
            "      --exposure EV       PNG exposure in stops (default 0)\n"
            "\n"
            "Bidirectional and point-light methods (bdpt, ir, rigi):\n"
-           "      --mis KIND          bdpt weights: balance, power (default) or stratified\n"
+           "      --mis KIND          bdpt weights: balance, power (default), stratified, or\n"
+           "                          light (light tracing alone: every path through t = 1)\n"
            "      --threshold t       stratification threshold on G (default: the scene's\n"
            "                          diagonal d gives t = 1 / (0.15 d)^2); printed when used\n"
            "      --light-paths K     K light paths per pass shared by all pixels\n"
@@ -212,8 +213,11 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->mis = CDL_MIS_POWER;
             else if (!strcmp(v, "stratified"))
                 a->mis = CDL_MIS_STRATIFIED;
+            else if (!strcmp(v, "light"))
+                a->mis = CDL_MIS_LIGHT_TRACING;
             else
-                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected balance, power or stratified, got '%s'", v);
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                                     "expected balance, power, stratified or light, got '%s'", v);
         } else if (!strcmp(o, "--light-paths")) {
             rc = cdl_arg_int(o, v, 1, 100000000L, &a->light_paths, err);
         } else if (!strcmp(o, "--interleave")) {
@@ -400,7 +404,7 @@ int cdl_cmd_render(int argc, char **argv)
     if (!rc)
         rc = cdl_integrator_create(a.integrator, &integ, &err);
     if (!rc && integ.vt->prepare(integ.self, &scene, &opt))
-        rc = cdl_error_set(&err, CDL_ERR_INPUT, a.scene, 0, "integrator %s could not prepare the scene",
+        rc = cdl_error_set(&err, CDL_ERR_INPUT, a.scene, 0, "integrator %s cannot render this scene (bdpt, ir and rigi do not support distant or infinite lights yet)",
                            a.integrator);
     if (!rc)
         rc = cdl_film_init(&film, a.width, a.height, &err);
@@ -464,21 +468,9 @@ int cdl_cmd_render(int argc, char **argv)
         layers[i] = (cdl_layer){film.aovs[i].name, &aov_img[i], film.aovs[i].channels == 1};
         nl = i + 1;
     }
-    for (int i = 0; !rc && i < a.nout; i++) {
-        rc = nl && cdl_image_has_ext(a.out[i], ".exr")
-                 ? cdl_image_write_layers(a.out[i], &img, layers, nl, meta, 5, &err)
-                 : cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
-        /* a PNG output also gets one PNG per layer: OUT.png -> OUT.NAME.png */
-        for (int l = 0; !rc && l < nl && cdl_image_has_ext(a.out[i], ".png"); l++) {
-            char path[1100];
-            snprintf(path, sizeof path, "%.*s.%s.png", (int)(strlen(a.out[i]) - 4), a.out[i], layers[l].name);
-            if (layers[l].grey)
-                false_colour(&aov_img[l]);
-            rc = cdl_image_write(path, &aov_img[l], meta, 5, layers[l].grey ? 0.0f : (float)a.exposure, &err);
-        }
-    }
     for (int i = 0; !rc && i < nl; i++) {
-        /* statistics of one-channel layers (e.g. the eye path length) */
+        /* statistics of one-channel layers (e.g. the eye path length),
+         * before the PNG false colours overwrite them */
         if (!layers[i].grey)
             continue;
         double sum = 0.0, mx = 0.0;
@@ -488,6 +480,27 @@ int cdl_cmd_render(int argc, char **argv)
             mx = aov_img[i].rgb[3 * k] > mx ? aov_img[i].rgb[3 * k] : mx;
         }
         printf("%s: mean %.4f, max %.4f per pixel\n", layers[i].name, sum / (double)n, mx);
+    }
+    for (int i = 0; !rc && i < a.nout; i++) {
+        rc = nl && cdl_image_has_ext(a.out[i], ".exr")
+                 ? cdl_image_write_layers(a.out[i], &img, layers, nl, meta, 5, &err)
+                 : cdl_image_write(a.out[i], &img, meta, 5, (float)a.exposure, &err);
+        /* a PNG output also gets one PNG per layer: OUT.png -> OUT.NAME.png */
+        for (int l = 0; !rc && l < nl && cdl_image_has_ext(a.out[i], ".png"); l++) {
+            char path[1100];
+            snprintf(path, sizeof path, "%.*s.%s.png", (int)(strlen(a.out[i]) - 4), a.out[i], layers[l].name);
+            cdl_image view = aov_img[l];
+            if (layers[l].grey) { /* false colours on a copy: other outputs keep the values */
+                rc = cdl_image_alloc(&view, img.width, img.height, &err);
+                if (rc)
+                    break;
+                memcpy(view.rgb, aov_img[l].rgb, sizeof(float) * 3 * (size_t)img.width * (size_t)img.height);
+                false_colour(&view);
+            }
+            rc = cdl_image_write(path, &view, meta, 5, layers[l].grey ? 0.0f : (float)a.exposure, &err);
+            if (layers[l].grey)
+                cdl_image_free(&view);
+        }
     }
     for (int i = 0; i < nl; i++)
         cdl_image_free(&aov_img[i]);

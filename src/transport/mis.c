@@ -42,6 +42,8 @@ float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, i
 {
     if (kind == CDL_MIS_STRATIFIED)
         return stratified(v, s, t, delta_light, threshold);
+    if (kind == CDL_MIS_LIGHT_TRACING)
+        return (t == 1 || s + t == 2) ? 1.0f : 0.0f;
     if (s + t == 2)
         return 1.0f;
     int pw = kind == CDL_MIS_POWER;

@@ -9,7 +9,12 @@
 #ifndef CDL_MIS_H
 #define CDL_MIS_H
 
-typedef enum cdl_mis_kind { CDL_MIS_BALANCE, CDL_MIS_POWER, CDL_MIS_STRATIFIED } cdl_mis_kind;
+typedef enum cdl_mis_kind {
+    CDL_MIS_BALANCE,
+    CDL_MIS_POWER,
+    CDL_MIS_STRATIFIED,
+    CDL_MIS_LIGHT_TRACING /* only t = 1 (and lights seen directly): pure light tracing */
+} cdl_mis_kind;
 
 typedef struct cdl_mis_vertex {
     float pdf_eye;   /* area density of this vertex sampled from the eye side (from z_{k-1}) */
