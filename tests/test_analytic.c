@@ -101,23 +101,27 @@ static void furnace(const char *integ)
     cdl_scene_free(&s);
 }
 
+/* A Lambertian square y = 0, |x|, |z| <= 10, facing up, of albedo rho. */
+static void add_ground(cdl_scene *s, float rho)
+{
+    cdl_error err;
+    cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
+    m.kd = cdl_v3(rho, rho, rho);
+    uint32_t mid, first;
+    die_on(cdl_scene_add_material(s, &m, &mid, &err), &err);
+    float p[12] = {-10, 0, -10, 10, 0, -10, 10, 0, 10, -10, 0, 10};
+    die_on(cdl_scene_add_vertices(s, 4, p, NULL, NULL, &first, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 2, first + 1, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 3, first + 2, mid, -1, 0, &err), &err);
+}
+
 static void plane(const char *integ)
 {
     cdl_scene s;
     cdl_error err;
     die_on(cdl_scene_init(&s, "plane", &err), &err);
     const float rho = 0.5f, I = 10.0f, h = 1.0f;
-    cdl_material m;
-    memset(&m, 0, sizeof m);
-    m.type = CDL_MAT_DIFFUSE;
-    m.kd = cdl_v3(rho, rho, rho);
-    m.kd_tex = -1;
-    uint32_t mid, first;
-    die_on(cdl_scene_add_material(&s, &m, &mid, &err), &err);
-    float p[12] = {-10, 0, -10, 10, 0, -10, 10, 0, 10, -10, 0, 10};
-    die_on(cdl_scene_add_vertices(&s, 4, p, NULL, NULL, &first, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 1, mid, -1, 0, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 3, first + 2, mid, -1, 0, &err), &err);
+    add_ground(&s, rho);
     cdl_vec3 lp = cdl_v3(0.3f, h, -0.2f);
     die_on(cdl_scene_add_point_light(&s, lp, cdl_v3(I, I, I), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
@@ -175,22 +179,13 @@ static void sphere_light(const char *integ)
     cdl_error err;
     die_on(cdl_scene_init(&s, "sphere-light", &err), &err);
     const float rho = 0.5f, Le = 10.0f, r = 0.3f;
-    cdl_material m;
-    memset(&m, 0, sizeof m);
-    m.type = CDL_MAT_DIFFUSE;
-    m.kd = cdl_v3(rho, rho, rho);
-    m.kd_tex = -1;
-    cdl_material black = m;
+    add_ground(&s, rho);
+    cdl_material black = cdl_material_default(CDL_MAT_DIFFUSE);
     black.kd = cdl_v3(0.0f, 0.0f, 0.0f);
-    uint32_t mid, bid, first;
+    uint32_t bid;
     int32_t emit;
-    die_on(cdl_scene_add_material(&s, &m, &mid, &err), &err);
     die_on(cdl_scene_add_material(&s, &black, &bid, &err), &err);
     die_on(cdl_scene_add_emitter(&s, cdl_v3(Le, Le, Le), 0, &emit, &err), &err);
-    float p[12] = {-10, 0, -10, 10, 0, -10, 10, 0, 10, -10, 0, 10};
-    die_on(cdl_scene_add_vertices(&s, 4, p, NULL, NULL, &first, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 1, mid, -1, 0, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 3, first + 2, mid, -1, 0, &err), &err);
     cdl_vec3 c = cdl_v3(0.5f, 1.2f, -0.1f);
     die_on(cdl_scene_add_sphere(&s, c, r, bid, emit, 0, &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
