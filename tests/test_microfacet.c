@@ -706,16 +706,8 @@ static void test_microfacet(const mf_case *mc, double wo_deg, int tilted, uint64
     /* Reciprocity over random pairs too, and the support of pdf vs eval. */
     long nonzero = 0, pdf_no_f = 0, f_no_pdf = 0, edge = 0;
     for (int s = 0; s < 20000; s++) {
-        float z = 2.0f * cdl_rng_float(&rng) - 1.0f, ph = 2.0f * CDL_PI * cdl_rng_float(&rng);
-        float rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        cdl_vec3 a = cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
-        cdl_vec3 bb = wo;
-        if (s & 1) {
-            z = 2.0f * cdl_rng_float(&rng) - 1.0f;
-            ph = 2.0f * CDL_PI * cdl_rng_float(&rng);
-            rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-            bb = cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
-        }
+        cdl_vec3 a = random_sphere_dir(&rng);
+        cdl_vec3 bb = (s & 1) ? random_sphere_dir(&rng) : wo;
         cdl_vec3 f1 = cdl_bsdf_eval(&b, bb, a, 0), f2 = cdl_bsdf_eval(&b, a, bb, 0);
         float p1 = cdl_bsdf_pdf(&b, bb, a);
         if (!cdl_is_black(f1))

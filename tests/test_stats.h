@@ -27,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "core/rng.h"
 #include "core/vec.h"
 #include "scene/bsdf.h"
 
@@ -412,6 +413,14 @@ static TS_UNUSED double fresnel_ref(double ti, double eta_i, double eta_t)
     }
     double rs = sin(ti - tt) / sin(ti + tt), rp = tan(ti - tt) / tan(ti + tt);
     return 0.5 * (rs * rs + rp * rp);
+}
+
+/* A uniform direction on the sphere (float, as the BSDFs take them). */
+static TS_UNUSED cdl_vec3 random_sphere_dir(cdl_rng *rng)
+{
+    float z = 2.0f * cdl_rng_float(rng) - 1.0f, ph = 2.0f * CDL_PI * cdl_rng_float(rng);
+    float rr = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    return cdl_v3(rr * cosf(ph), rr * sinf(ph), z);
 }
 
 #endif
