@@ -1,0 +1,238 @@
+#include "spatial/pointkd.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static float coord(const cdl_kdtree *t, uint32_t i, int a) { return t->pts[(size_t)i * t->stride + (size_t)a]; }
+
+/* Quickselect with a three-way partition (robust to equal coordinates):
+ * afterwards idx[k] holds the k-th smallest coordinate of idx[lo..hi),
+ * with nothing larger before it and nothing smaller after it. */
+static void select_kth(const cdl_kdtree *t, uint32_t *idx, uint32_t lo, uint32_t hi, uint32_t k, int a)
+{
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        float x = coord(t, idx[lo], a), y = coord(t, idx[mid], a), z = coord(t, idx[hi - 1], a);
+        float pivot = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+        uint32_t lt = lo, i = lo, gt = hi;
+        while (i < gt) {
+            float c = coord(t, idx[i], a);
+            uint32_t tmp = idx[i];
+            if (c < pivot) {
+                idx[i++] = idx[lt];
+                idx[lt++] = tmp;
+            } else if (c > pivot) {
+                idx[i] = idx[--gt];
+                idx[gt] = tmp;
+            } else {
+                i++;
+            }
+        }
+        if (k < lt)
+            hi = lt;
+        else if (k >= gt)
+            lo = gt;
+        else
+            return;
+    }
+}
+
+static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi)
+{
+    while (hi - lo > 1) {
+        float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (uint32_t i = lo; i < hi; i++)
+            for (int a = 0; a < 3; a++) {
+                float c = coord(t, t->idx[i], a);
+                mn[a] = c < mn[a] ? c : mn[a];
+                mx[a] = c > mx[a] ? c : mx[a];
+            }
+        int a = 0;
+        for (int b = 1; b < 3; b++)
+            if (mx[b] - mn[b] > mx[a] - mn[a])
+                a = b;
+        uint32_t mid = lo + (hi - lo) / 2;
+        select_kth(t, t->idx, lo, hi, mid, a);
+        t->axis[mid] = (uint8_t)a;
+        build(t, lo, mid); /* recursion depth is log2(n) */
+        lo = mid + 1;
+    }
+    if (hi - lo == 1)
+        t->axis[lo] = 0;
+}
+
+int cdl_kd_build(cdl_kdtree *t, const float *pts, uint32_t stride, uint32_t n, cdl_error *err)
+{
+    memset(t, 0, sizeof *t);
+    t->pts = pts;
+    t->stride = stride < 3 ? 3 : stride;
+    for (uint32_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++)
+            if (!isfinite(pts[(size_t)i * t->stride + (size_t)a]))
+                return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "kd-tree: point %u is not finite", i);
+    t->idx = malloc(sizeof(uint32_t) * (n ? n : 1));
+    t->axis = malloc(n ? n : 1);
+    if (!t->idx || !t->axis) {
+        cdl_kd_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for a kd-tree of %u points", n);
+    }
+    for (uint32_t i = 0; i < n; i++)
+        t->idx[i] = i;
+    t->n = n;
+    build(t, 0, n);
+    return 0;
+}
+
+void cdl_kd_free(cdl_kdtree *t)
+{
+    free(t->idx);
+    free(t->axis);
+    t->idx = NULL;
+    t->axis = NULL;
+    t->n = 0;
+}
+
+static float dist2(const cdl_kdtree *t, uint32_t i, cdl_vec3 q)
+{
+    const float *p = t->pts + (size_t)i * t->stride;
+    float dx = p[0] - q.x, dy = p[1] - q.y, dz = p[2] - q.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/* k-NN state: a max-heap on distance of the best candidates so far. */
+typedef struct knn {
+    uint32_t k, n;
+    uint32_t *idx;
+    float *d2;
+    float r2; /* current search radius^2: max_d2, or the heap's top when full */
+} knn;
+
+static void heap_push(knn *h, uint32_t i, float d)
+{
+    if (h->n < h->k) {
+        uint32_t c = h->n++;
+        while (c > 0) {
+            uint32_t p = (c - 1) / 2;
+            if (h->d2[p] >= d)
+                break;
+            h->d2[c] = h->d2[p];
+            h->idx[c] = h->idx[p];
+            c = p;
+        }
+        h->d2[c] = d;
+        h->idx[c] = i;
+    } else {
+        /* replace the farthest and sift down */
+        uint32_t c = 0;
+        for (;;) {
+            uint32_t l = 2 * c + 1, r = l + 1, m = c;
+            float dm = d;
+            if (l < h->n && h->d2[l] > dm) {
+                m = l;
+                dm = h->d2[l];
+            }
+            if (r < h->n && h->d2[r] > dm)
+                m = r;
+            if (m == c)
+                break;
+            h->d2[c] = h->d2[m];
+            h->idx[c] = h->idx[m];
+            c = m;
+        }
+        h->d2[c] = d;
+        h->idx[c] = i;
+    }
+    if (h->n == h->k)
+        h->r2 = h->d2[0];
+}
+
+static void knn_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, knn *h)
+{
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2, p = t->idx[mid];
+        float d = dist2(t, p, q);
+        if (d <= h->r2)
+            heap_push(h, p, d);
+        int a = t->axis[mid];
+        float delta = (a == 0 ? q.x : a == 1 ? q.y : q.z) - coord(t, p, a);
+        /* nearer half first; the farther one only if the plane is in range */
+        uint32_t nlo = delta < 0.0f ? lo : mid + 1, nhi = delta < 0.0f ? mid : hi;
+        uint32_t flo = delta < 0.0f ? mid + 1 : lo, fhi = delta < 0.0f ? hi : mid;
+        knn_search(t, nlo, nhi, q, h);
+        if (delta * delta > h->r2)
+            return;
+        lo = flo;
+        hi = fhi;
+    }
+}
+
+uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out, float *d2)
+{
+    if (k == 0 || t->n == 0)
+        return 0;
+    knn h = {k, 0, out, d2, max_d2};
+    knn_search(t, 0, t->n, q, &h);
+    /* heap sort into ascending distance */
+    uint32_t n = h.n;
+    for (uint32_t end = n; end > 1; end--) {
+        float dl = h.d2[end - 1];
+        uint32_t il = h.idx[end - 1];
+        h.d2[end - 1] = h.d2[0];
+        h.idx[end - 1] = h.idx[0];
+        h.n = end - 1;
+        /* sift the former last element down from the root */
+        uint32_t c = 0;
+        for (;;) {
+            uint32_t l = 2 * c + 1, r = l + 1, m = c;
+            float dm = dl;
+            if (l < h.n && h.d2[l] > dm) {
+                m = l;
+                dm = h.d2[l];
+            }
+            if (r < h.n && h.d2[r] > dm)
+                m = r;
+            if (m == c)
+                break;
+            h.d2[c] = h.d2[m];
+            h.idx[c] = h.idx[m];
+            c = m;
+        }
+        h.d2[c] = dl;
+        h.idx[c] = il;
+    }
+    return n;
+}
+
+static uint32_t ball_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2,
+                            cdl_kd_visit fn, void *ctx)
+{
+    uint32_t count = 0;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2, p = t->idx[mid];
+        float d = dist2(t, p, q);
+        if (d <= r2) {
+            fn(ctx, p, d);
+            count++;
+        }
+        int a = t->axis[mid];
+        float delta = (a == 0 ? q.x : a == 1 ? q.y : q.z) - coord(t, p, a);
+        /* left half holds coordinates <= the split, right half >= */
+        int go_left = delta <= 0.0f || delta * delta <= r2;
+        int go_right = delta >= 0.0f || delta * delta <= r2;
+        if (go_left && go_right) {
+            count += ball_search(t, lo, mid, q, r2, fn, ctx);
+            lo = mid + 1;
+        } else if (go_left) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    return count;
+}
+
+uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn, void *ctx)
+{
+    return t->n ? ball_search(t, 0, t->n, q, r2, fn, ctx) : 0;
+}

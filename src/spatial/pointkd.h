@@ -1,0 +1,40 @@
+/* A balanced kd-tree over points (photons, importons, light vertices):
+ * k nearest neighbours within a maximum radius, and ball queries. Built
+ * in place over an index array by median splits on the widest axis: the
+ * node of a segment [lo, hi) is its middle element, its children the two
+ * halves, so the tree needs no pointers (one index and one axis byte per
+ * point). */
+#ifndef CDL_POINTKD_H
+#define CDL_POINTKD_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+
+typedef struct cdl_kdtree {
+    uint32_t n;
+    uint32_t *idx;     /* point index of each tree position */
+    uint8_t *axis;     /* split axis of each tree position */
+    const float *pts;  /* point i at pts[i * stride .. + 2] (not owned) */
+    uint32_t stride;   /* floats between consecutive points */
+} cdl_kdtree;
+
+/* Builds over n points; pts must outlive the tree. Non-finite points are
+ * an error (they would break the ordering). */
+int cdl_kd_build(cdl_kdtree *t, const float *pts, uint32_t stride, uint32_t n, cdl_error *err);
+void cdl_kd_free(cdl_kdtree *t);
+
+/* The k nearest points with squared distance <= max_d2: their indices in
+ * out[] and squared distances in d2[], nearest first. Returns the count. */
+uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out,
+                    float *d2);
+
+/* Calls fn for every point with squared distance <= r2; returns the count. */
+typedef void (*cdl_kd_visit)(void *ctx, uint32_t point, float d2);
+uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn, void *ctx);
+
+/* Bytes held by the tree (not the points). */
+static inline size_t cdl_kd_bytes(const cdl_kdtree *t) { return (size_t)t->n * 5u; }
+
+#endif
