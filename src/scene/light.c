@@ -4,6 +4,27 @@
 
 #include "core/sampling.h"
 
+/* A uniform point on a triangle light. */
+static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2)
+{
+    float b1, b2;
+    cdl_sample_triangle(u1, u2, &b1, &b2);
+    return cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+}
+
+/* A cosine-distributed emission direction about e->n (area lights);
+ * face_prob is the probability the face e->n was chosen with. */
+static int emit_cosine(cdl_light_emit *e, float u3, float u4, float face_prob)
+{
+    cdl_frame f = cdl_frame_from(e->n);
+    cdl_vec3 local = cdl_sample_cosine_hemisphere(u3, u4);
+    if (local.z <= 0.0f)
+        return 0;
+    e->d = cdl_to_world(&f, local);
+    e->pdf_dir = local.z * CDL_INV_PI * face_prob;
+    return 1;
+}
+
 /* pbrt-v3's spot falloff: smooth fourth power between the two cones. */
 static float spot_falloff(const cdl_light *l, float cos_t)
 {
@@ -112,9 +133,7 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    float b1, b2;
-    cdl_sample_triangle(u1, u2, &b1, &b2);
-    s->p = cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+    s->p = triangle_point(l, u1, u2);
     cdl_vec3 d = cdl_sub(s->p, ref);
     float d2 = cdl_dot(d, d);
     if (!(d2 > 0.0f))
@@ -215,39 +234,24 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
         cdl_vec3 n = cdl_sample_uniform_sphere(u1, u2);
         e->p = cdl_madd(l->p, n, l->radius);
         e->n = l->inward ? cdl_neg(n) : n;
-        cdl_frame f = cdl_frame_from(e->n);
-        cdl_vec3 local = cdl_sample_cosine_hemisphere(u3, u4);
-        if (local.z <= 0.0f)
-            return 0;
-        e->d = cdl_to_world(&f, local);
         e->Le = l->L;
         e->pdf_pos = 1.0f / l->area;
-        e->pdf_dir = local.z * CDL_INV_PI;
-        return 1;
+        return emit_cosine(e, u3, u4, 1.0f);
     }
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    float b1, b2;
-    cdl_sample_triangle(u1, u2, &b1, &b2);
-    e->p = cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+    e->p = triangle_point(l, u1, u2);
     e->n = l->n;
-    float side = 1.0f, pick = u3;
+    float pick = u3;
     if (l->twosided) {
         /* choose a face with probability 1/2, reusing u3 */
-        side = u3 < 0.5f ? 1.0f : -1.0f;
         pick = u3 < 0.5f ? 2.0f * u3 : 2.0f * u3 - 1.0f;
-        e->n = cdl_scale(l->n, side);
+        e->n = cdl_scale(l->n, u3 < 0.5f ? 1.0f : -1.0f);
     }
-    cdl_frame f = cdl_frame_from(e->n);
-    cdl_vec3 local = cdl_sample_cosine_hemisphere(pick, u4);
-    if (local.z <= 0.0f)
-        return 0;
-    e->d = cdl_to_world(&f, local);
     e->Le = l->L;
     e->pdf_pos = 1.0f / l->area;
-    e->pdf_dir = local.z * CDL_INV_PI * (l->twosided ? 0.5f : 1.0f);
-    return 1;
+    return emit_cosine(e, pick, u4, l->twosided ? 0.5f : 1.0f);
 }
 
 cdl_vec3 cdl_light_power(const cdl_light *l)

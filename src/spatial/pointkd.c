@@ -108,6 +108,29 @@ typedef struct knn {
     float r2; /* current search radius^2: max_d2, or the heap's top when full */
 } knn;
 
+/* Puts (i, d) at the root of the first h->n entries and sifts it down. */
+static void sift_down(knn *h, uint32_t i, float d)
+{
+    uint32_t c = 0;
+    for (;;) {
+        uint32_t l = 2 * c + 1, r = l + 1, m = c;
+        float dm = d;
+        if (l < h->n && h->d2[l] > dm) {
+            m = l;
+            dm = h->d2[l];
+        }
+        if (r < h->n && h->d2[r] > dm)
+            m = r;
+        if (m == c)
+            break;
+        h->d2[c] = h->d2[m];
+        h->idx[c] = h->idx[m];
+        c = m;
+    }
+    h->d2[c] = d;
+    h->idx[c] = i;
+}
+
 static void heap_push(knn *h, uint32_t i, float d)
 {
     if (h->n < h->k) {
@@ -123,25 +146,7 @@ static void heap_push(knn *h, uint32_t i, float d)
         h->d2[c] = d;
         h->idx[c] = i;
     } else {
-        /* replace the farthest and sift down */
-        uint32_t c = 0;
-        for (;;) {
-            uint32_t l = 2 * c + 1, r = l + 1, m = c;
-            float dm = d;
-            if (l < h->n && h->d2[l] > dm) {
-                m = l;
-                dm = h->d2[l];
-            }
-            if (r < h->n && h->d2[r] > dm)
-                m = r;
-            if (m == c)
-                break;
-            h->d2[c] = h->d2[m];
-            h->idx[c] = h->idx[m];
-            c = m;
-        }
-        h->d2[c] = d;
-        h->idx[c] = i;
+        sift_down(h, i, d); /* replaces the farthest */
     }
     if (h->n == h->k)
         h->r2 = h->d2[0];
@@ -181,25 +186,7 @@ uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, u
         h.d2[end - 1] = h.d2[0];
         h.idx[end - 1] = h.idx[0];
         h.n = end - 1;
-        /* sift the former last element down from the root */
-        uint32_t c = 0;
-        for (;;) {
-            uint32_t l = 2 * c + 1, r = l + 1, m = c;
-            float dm = dl;
-            if (l < h.n && h.d2[l] > dm) {
-                m = l;
-                dm = h.d2[l];
-            }
-            if (r < h.n && h.d2[r] > dm)
-                m = r;
-            if (m == c)
-                break;
-            h.d2[c] = h.d2[m];
-            h.idx[c] = h.idx[m];
-            c = m;
-        }
-        h.d2[c] = dl;
-        h.idx[c] = il;
+        sift_down(&h, il, dl);
     }
     return n;
 }
