@@ -4,6 +4,7 @@
 /* Each returns the process exit status. */
 int cdl_cmd_render(int argc, char **argv);
 int cdl_cmd_diff(int argc, char **argv);
+int cdl_cmd_photons(int argc, char **argv);
 
 /* Prints "candela: error: ..." for err and returns its exit status. */
 struct cdl_error;

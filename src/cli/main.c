@@ -19,6 +19,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: candela render SCENE [options]    render a scene\n"
+            "       candela photons SCENE [options]   the photon map (and importons) from above\n"
             "       candela diff TEST REF [--heatmap OUT.png]\n"
             "                                         compare two images\n"
             "       candela --help | --version\n"
@@ -34,6 +35,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "render"))
         return cdl_cmd_render(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "photons"))
+        return cdl_cmd_photons(argc - 1, argv + 1);
     if (!strcmp(argv[1], "diff"))
         return cdl_cmd_diff(argc - 1, argv + 1);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {

@@ -12,39 +12,14 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/pm_args.h"
+#include "cli/render_args.h"
 #include "core/log.h"
 #include "film/film.h"
 #include "film/image.h"
 #include "integrators/integrator.h"
 #include "scene/loader.h"
 
-#define MAX_OUT 8
-#define MAX_POINT_LIGHTS 64
-
-typedef struct render_args {
-    const char *scene, *integrator;
-    const char *out[MAX_OUT];
-    int nout;
-    long spp;
-    double time;
-    int width, height;
-    int has_lookat;
-    float lookat[9];
-    double fov;
-    long maxdepth, threads;
-    unsigned long long seed;
-    float lights[MAX_POINT_LIGHTS][6];
-    int nlights;
-    double exposure;
-    cdl_sampler_kind sampler;
-    cdl_mis_kind mis;
-    long light_paths, interleave;
-    double threshold, clamp;
-    int strata_distance, single_shadow_rays;
-    int aov_pathlength, aov_strata;
-    /* given on the command line (else the scene file or the default decides) */
-    int has_integrator, has_res, has_fov, has_maxdepth;
-} render_args;
 
 static void render_help(void)
 {
@@ -85,10 +60,11 @@ static void render_help(void)
            "                          length, Fig. 4) or strata (the contribution of each\n"
            "                          eye path length as layers strata1..strata8, Fig. 5)\n"
            "      --shadow-rays KIND  rigi/ir: bundle (one Embree stream per point light and\n"
-           "                          tile, default) or single\n"
+           "                          tile, default) or single; pm: a number (below)\n"
            "  -q, --quiet             no warnings, no progress bar\n"
-           "\n"
-           "Integrators:\n");
+           "\n");
+    cdl_pm_args_help();
+    printf("Integrators:\n");
     for (const cdl_integrator_vtbl *const *it = cdl_integrator_list(); *it; it++)
         printf("  %-8s %s\n", (*it)->name, (*it)->summary);
     printf("\nThe summary line gives wall time, samples per pixel and Mrays/s (all rays\n"
@@ -115,9 +91,12 @@ static int check_output(const char *path, cdl_error *err)
     return 0;
 }
 
-static int parse(int argc, char **argv, render_args *a, cdl_error *err)
+int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
 {
     memset(a, 0, sizeof *a);
+    cdl_options defaults;
+    cdl_options_default(&defaults);
+    a->pm = defaults.pm;
     a->integrator = "path";
     a->spp = 0;
     a->width = 512;
@@ -141,6 +120,19 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
             if (a->scene)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "only one scene file may be given");
             a->scene = o;
+            continue;
+        }
+        int pk = cdl_pm_arg_kind(o);
+        if (pk == 2) {
+            cdl_pm_arg(o, NULL, &a->pm, err);
+            continue;
+        }
+        if (pk == 1) {
+            if (i + 1 >= argc)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
+            int prc = cdl_pm_arg(o, argv[++i], &a->pm, err);
+            if (prc)
+                return prc;
             continue;
         }
         /* Every other option takes the next argument as its value, even
@@ -245,8 +237,11 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->single_shadow_rays = 0;
             else if (!strcmp(v, "single"))
                 a->single_shadow_rays = 1;
-            else
-                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected bundle or single, got '%s'", v);
+            else if (v[0] >= '0' && v[0] <= '9') { /* pm: rays per shading point */
+                rc = cdl_arg_int(o, v, 1, 4096, &l, err);
+                a->pm.shadow_rays = (uint32_t)l;
+            } else
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected bundle, single or a ray count, got '%s'", v);
         } else if (!strcmp(o, "--exposure")) {
             rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
             a->exposure = d;
@@ -271,7 +266,7 @@ static int parse(int argc, char **argv, render_args *a, cdl_error *err)
     }
     if (a->spp && a->time > 0.0)
         return cdl_error_set(err, CDL_ERR_USAGE, "--time", 0, "give either --spp or --time, not both");
-    return 0;
+    return cdl_pm_args_check(&a->pm, err);
 }
 
 /* Scene-file settings fill in what the command line left open. */
@@ -345,11 +340,55 @@ static void default_output(const char *scene, const cdl_scene_settings *set, cha
     snprintf(buf, n, "%.*s.exr", len, base);
 }
 
+int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, cdl_options *opt,
+                     char *defout, size_t ndefout, cdl_error *err)
+{
+    int rc;
+    rc = cdl_scene_init(scene, a->scene, err);
+    if (!rc)
+        rc = cdl_scene_load(scene, a->scene, set, err);
+    for (int i = 0; !rc && i < a->nlights; i++)
+        rc = cdl_scene_add_point_light(scene, cdl_v3(a->lights[i][0], a->lights[i][1], a->lights[i][2]),
+                                       cdl_v3(a->lights[i][3], a->lights[i][4], a->lights[i][5]), err);
+    if (!rc)
+        rc = cdl_scene_commit(scene, err);
+    if (!rc) {
+        apply_settings(a, set);
+        if (a->nout == 0) {
+            default_output(a->scene, set, defout, ndefout);
+            a->out[a->nout++] = defout;
+        }
+    }
+    cdl_options_default(opt);
+    opt->maxdepth = (int)a->maxdepth;
+    opt->seed = a->seed;
+    opt->sampler = a->sampler;
+    opt->mis = a->mis;
+    opt->light_paths = (uint32_t)a->light_paths;
+    opt->interleave = (uint32_t)a->interleave;
+    opt->threshold = (float)a->threshold;
+    opt->clamp = (float)a->clamp;
+    opt->strata_distance = a->strata_distance;
+    opt->single_shadow_rays = a->single_shadow_rays;
+    opt->pm = a->pm;
+    if (!rc && a->has_lookat)
+        rc = cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
+                             cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),
+                             cdl_v3(a->lookat[6], a->lookat[7], a->lookat[8]), (float)a->fov, a->width,
+                             a->height, err);
+    else if (!rc && set->has_camera)
+        rc = cdl_camera_init_frame(&opt->camera, set->eye, set->right, set->up, set->fwd,
+                                   a->has_fov ? (float)a->fov : set->fov, a->width, a->height, err);
+    else if (!rc)
+        rc = frame_scene(scene, a->fov, a->width, a->height, &opt->camera, err);
+    return rc;
+}
+
 int cdl_cmd_render(int argc, char **argv)
 {
     render_args a;
     cdl_error err;
-    int rc = parse(argc, argv, &a, &err);
+    int rc = cdl_render_parse(argc, argv, &a, &err);
     if (rc < 0)
         return 0;
     if (rc)
@@ -365,47 +404,11 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_integrator integ = {0};
     cdl_film film = {0};
     cdl_image img = {0};
-    rc = cdl_scene_init(&scene, a.scene, &err);
-    if (!rc)
-        rc = cdl_scene_load(&scene, a.scene, &set, &err);
-    for (int i = 0; !rc && i < a.nlights; i++)
-        rc = cdl_scene_add_point_light(&scene, cdl_v3(a.lights[i][0], a.lights[i][1], a.lights[i][2]),
-                                       cdl_v3(a.lights[i][3], a.lights[i][4], a.lights[i][5]), &err);
-    if (!rc)
-        rc = cdl_scene_commit(&scene, &err);
-    if (!rc) {
-        apply_settings(&a, &set);
-        if (a.nout == 0) {
-            default_output(a.scene, &set, defout, sizeof defout);
-            a.out[a.nout++] = defout;
-        }
-    }
-    cdl_options_default(&opt);
-    opt.maxdepth = (int)a.maxdepth;
-    opt.seed = a.seed;
-    opt.sampler = a.sampler;
-    opt.mis = a.mis;
-    opt.light_paths = (uint32_t)a.light_paths;
-    opt.interleave = (uint32_t)a.interleave;
-    opt.threshold = (float)a.threshold;
-    opt.clamp = (float)a.clamp;
-    opt.strata_distance = a.strata_distance;
-    opt.single_shadow_rays = a.single_shadow_rays;
-    if (!rc && a.has_lookat)
-        rc = cdl_camera_init(&opt.camera, cdl_v3(a.lookat[0], a.lookat[1], a.lookat[2]),
-                             cdl_v3(a.lookat[3], a.lookat[4], a.lookat[5]),
-                             cdl_v3(a.lookat[6], a.lookat[7], a.lookat[8]), (float)a.fov, a.width,
-                             a.height, &err);
-    else if (!rc && set.has_camera)
-        rc = cdl_camera_init_frame(&opt.camera, set.eye, set.right, set.up, set.fwd,
-                                   a.has_fov ? (float)a.fov : set.fov, a.width, a.height, &err);
-    else if (!rc)
-        rc = frame_scene(&scene, a.fov, a.width, a.height, &opt.camera, &err);
+    rc = cdl_render_setup(&a, &scene, &set, &opt, defout, sizeof defout, &err);
     if (!rc)
         rc = cdl_integrator_create(a.integrator, &integ, &err);
-    if (!rc && integ.vt->prepare(integ.self, &scene, &opt))
-        rc = cdl_error_set(&err, CDL_ERR_INPUT, a.scene, 0, "integrator %s cannot render this scene (bdpt, ir and rigi do not support distant or infinite lights yet)",
-                           a.integrator);
+    if (!rc)
+        rc = integ.vt->prepare(integ.self, &scene, &opt, &err);
     if (!rc)
         rc = cdl_film_init(&film, a.width, a.height, &err);
     if (!rc && a.aov_pathlength && cdl_film_add_aov(&film, "pathlength", 1, &err) < 0)
@@ -429,6 +432,7 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_progress_begin(&prog);
     double t0 = cdl_time_now();
     uint32_t pass = 0;
+    int pass_failed = 0;
     char label[64];
     for (;;) {
         double el = cdl_time_now() - t0;
@@ -436,7 +440,11 @@ int cdl_cmd_render(int argc, char **argv)
             break;
         if (cdl_cancel)
             break;
-        integ.vt->render_pass(integ.self, &film, pass);
+        if (integ.vt->render_pass(integ.self, &film, pass, &err)) {
+            cdl_progress_end(&prog);
+            pass_failed = cdl_report(&err); /* the passes done so far are still written */
+            break;
+        }
         if (cdl_cancel)
             break; /* the interrupted pass left some pixels with one more sample */
         pass++;
@@ -513,6 +521,8 @@ int cdl_cmd_render(int argc, char **argv)
                omp_get_max_threads(), (unsigned long long)film.nonfinite,
                cdl_cancel ? " (interrupted)" : "", a.out[0], a.nout > 1 ? " ..." : "");
     }
+    if (!rc && integ.vt->report)
+        integ.vt->report(integ.self);
     if (film.nonfinite && !cdl_log_quiet)
         cdl_warn(a.scene, 0, "%llu samples were NaN or infinite and counted as black",
                  (unsigned long long)film.nonfinite);
@@ -520,6 +530,8 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_film_free(&film);
     cdl_integrator_destroy(&integ);
     cdl_scene_free(&scene);
+    if (!status && pass_failed)
+        status = pass_failed;
     if (!status && cdl_cancel)
         return 130;
     return status;

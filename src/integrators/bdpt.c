@@ -32,7 +32,7 @@ typedef struct bdpt_state {
     int ntiles;
 } bdpt_state;
 
-static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
 {
     bdpt_state *st = self;
     st->scene = scene;
@@ -42,16 +42,16 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     st->threshold = cdl_default_threshold(scene, opt);
     for (uint32_t i = 0; i < scene->nlights; i++)
         if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
-            return CDL_ERR_INPUT; /* reported by the caller */
-    cdl_error err;
+            return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
+                                 "bdpt does not support distant or infinite lights yet");
     if (opt->light_paths && cdl_light_pool_init(&st->pool, opt->light_paths, opt->interleave,
-                                                opt->maxdepth, &err))
-        return err.code;
+                                                opt->maxdepth, err))
+        return err->code;
     int tx = (opt->camera.width + 15) / 16, ty = (opt->camera.height + 15) / 16;
     st->ntiles = tx * ty;
     int nlists = st->ntiles > 1024 ? st->ntiles : 1024;
     st->tile_splats = calloc((size_t)nlists, sizeof(cdl_splats));
-    return st->tile_splats ? 0 : CDL_ERR_SYSTEM;
+    return st->tile_splats ? 0 : cdl_error_set(err, CDL_ERR_SYSTEM, "bdpt", 0, "out of memory");
 }
 
 /* s = 1 by resampling a light point for eye vertex pt (pbrt-v3 does the
@@ -230,8 +230,9 @@ static void light_trace_pool(bdpt_state *st, cdl_film *film)
     film->rays += rays;
 }
 
-static int bdpt_render_pass(void *self, cdl_film *film, uint32_t pass)
+static int bdpt_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
+    (void)err;
     bdpt_state *st = self;
     if (st->opt.light_paths) {
         cdl_light_pool_trace(&st->pool, st->scene, &st->walk, st->opt.sampler, st->opt.seed, pass,

@@ -9,9 +9,11 @@ extern const cdl_integrator_vtbl cdl_path_integrator;
 extern const cdl_integrator_vtbl cdl_bdpt_integrator;
 extern const cdl_integrator_vtbl cdl_ir_integrator;
 extern const cdl_integrator_vtbl cdl_rigi_integrator;
+extern const cdl_integrator_vtbl cdl_pm_integrator;
 
 static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
-                                                 &cdl_ir_integrator, &cdl_rigi_integrator, NULL};
+                                                 &cdl_ir_integrator, &cdl_rigi_integrator,
+                                                 &cdl_pm_integrator, NULL};
 
 void cdl_options_default(cdl_options *o)
 {
@@ -21,6 +23,15 @@ void cdl_options_default(cdl_options *o)
     o->seed = 1;
     o->mis = CDL_MIS_POWER;
     o->interleave = 1;
+    o->pm.photons = 200000;
+    o->pm.k = 100;
+    o->pm.kernel = 1; /* cone */
+    o->pm.gather = 16;
+    o->pm.precompute = 4;
+    o->pm.importons = 1u << 17;
+    o->pm.eps = 0.01f;
+    o->pm.caustic_ratio = 1.0f;
+    o->pm.shadow_rays = 1;
 }
 
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)

@@ -16,6 +16,26 @@
 
 #define CDL_STRATA 8 /* --aov strata: eye path lengths 1..7 and 8 or more */
 
+/* pm: Jensen's photon map with the techniques of Keller & Wald 2000 */
+typedef struct cdl_pm_options {
+    uint32_t photons;       /* global photons stored per pass */
+    uint32_t k;             /* photons per radiance estimate */
+    float max_radius;       /* of an estimate; <= 0: 5 % of the scene's diagonal */
+    int kernel;             /* cdl_kernel */
+    uint32_t gather;        /* final gathering rays; 0 = direct visualization */
+    uint32_t precompute;    /* irradiance at every n-th photon for gather rays; 0 = off */
+    int importance;         /* importance-driven deposition (§2.1) */
+    uint64_t importons;     /* importon paths */
+    float eps;              /* lower bound of the deposition probability */
+    int discard;            /* drop photons below eps instead (biased) */
+    float caustic_ratio;    /* q (§2.2) */
+    int caustic_random;     /* per-photon test against q instead of the path prefix */
+    int direct;             /* cdl_direct_kind */
+    uint32_t shadow_rays;   /* S */
+    float lcon_radius;      /* L_con query radius; <= 0: the maximum radius */
+    uint64_t max_paths;     /* photon paths per pass before giving up; 0: 1000 per photon */
+} cdl_pm_options;
+
 typedef struct cdl_options {
     cdl_camera camera;
     int maxdepth;   /* bounces, as in pbrt: 1 = direct light only */
@@ -31,6 +51,8 @@ typedef struct cdl_options {
     float clamp;           /* ir: clamp G at this value; <= 0: derived from the scene */
     int strata_distance;   /* rigi: threshold the distance instead of G (Figure 2c) */
     int single_shadow_rays; /* rigi/ir: trace shadow rays one by one instead of as bundles */
+
+    cdl_pm_options pm;
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the
@@ -42,9 +64,11 @@ void cdl_options_default(cdl_options *o);
 typedef struct cdl_integrator_vtbl {
     const char *name;
     const char *summary; /* one line for --help */
-    int (*prepare)(void *self, const cdl_scene *scene, const cdl_options *opt);
-    int (*render_pass)(void *self, cdl_film *film, uint32_t pass);
+    /* Both return 0 or an error code with err filled in (file, problem). */
+    int (*prepare)(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err);
+    int (*render_pass)(void *self, cdl_film *film, uint32_t pass, cdl_error *err);
     void (*destroy)(void *self);
+    void (*report)(const void *self); /* optional: statistics after rendering (stdout) */
     size_t self_size;
 } cdl_integrator_vtbl;
 

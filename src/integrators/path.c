@@ -19,8 +19,9 @@ typedef struct path_state {
     cdl_options opt;
 } path_state;
 
-static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
 {
+    (void)err;
     path_state *ps = self;
     ps->scene = scene;
     ps->opt = *opt;
@@ -134,8 +135,9 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     return bad;
 }
 
-static int path_render_pass(void *self, cdl_film *film, uint32_t pass)
+static int path_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
+    (void)err;
     cdl_render_tiles(self, film, pass, path_tile);
     return 0;
 }

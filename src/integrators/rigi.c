@@ -35,7 +35,8 @@ typedef struct rigi_state {
     cdl_light_pool pool;
 } rigi_state;
 
-static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, int clamped)
+static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, int clamped,
+                   cdl_error *err)
 {
     rigi_state *st = self;
     st->scene = scene;
@@ -55,22 +56,23 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
         st->t = cdl_default_threshold(scene, opt);
     for (uint32_t i = 0; i < scene->nlights; i++)
         if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
-            return CDL_ERR_INPUT;
-    cdl_error err;
+            return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
+                                 "%s does not support distant or infinite lights yet",
+                                 clamped ? "ir" : "rigi");
     uint32_t k = opt->light_paths ? opt->light_paths : 1024;
-    if (cdl_light_pool_init(&st->pool, k, opt->interleave, opt->maxdepth, &err))
-        return err.code;
+    if (cdl_light_pool_init(&st->pool, k, opt->interleave, opt->maxdepth, err))
+        return err->code;
     return 0;
 }
 
-static int rigi_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+static int rigi_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
 {
-    return prepare(self, scene, opt, 0);
+    return prepare(self, scene, opt, 0, err);
 }
 
-static int ir_prepare(void *self, const cdl_scene *scene, const cdl_options *opt)
+static int ir_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
 {
-    return prepare(self, scene, opt, 1);
+    return prepare(self, scene, opt, 1, err);
 }
 
 /* The stratification function: G, or 1 / d^2 for --strata distance. */
@@ -364,8 +366,9 @@ free(w);
     return bad;
 }
 
-static int rigi_render_pass(void *self, cdl_film *film, uint32_t pass)
+static int rigi_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
+    (void)err;
     rigi_state *st = self;
     cdl_light_pool_trace(&st->pool, st->scene, &st->walk, st->opt.sampler, st->opt.seed, pass, &film->rays);
     cdl_render_tiles(self, film, pass, rigi_tile);

@@ -84,6 +84,12 @@ int cdl_kd_build(cdl_kdtree *t, const float *pts, uint32_t stride, uint32_t n, c
     return 0;
 }
 
+void cdl_kd_make_identity(cdl_kdtree *t)
+{
+    for (uint32_t i = 0; i < t->n; i++)
+        t->idx[i] = i;
+}
+
 void cdl_kd_free(cdl_kdtree *t)
 {
     free(t->idx);
@@ -170,6 +176,15 @@ static void knn_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q
         lo = flo;
         hi = fhi;
     }
+}
+
+uint32_t cdl_kd_knn_heap(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out, float *d2)
+{
+    if (k == 0 || t->n == 0)
+        return 0;
+    knn h = {k, 0, out, d2, max_d2};
+    knn_search(t, 0, t->n, q, &h);
+    return h.n;
 }
 
 uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out, float *d2)

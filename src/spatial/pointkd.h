@@ -30,6 +30,15 @@ void cdl_kd_free(cdl_kdtree *t);
 uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out,
                     float *d2);
 
+/* The same points unsorted, as a max-heap: d2[0] is the largest (what a
+ * density estimate needs, without the cost of sorting). */
+uint32_t cdl_kd_knn_heap(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out,
+                         float *d2);
+
+/* For a caller that has moved point idx[i] to position i (tree order):
+ * the indirection becomes the identity, and traversal cache-friendly. */
+void cdl_kd_make_identity(cdl_kdtree *t);
+
 /* Calls fn for every point with squared distance <= r2; returns the count. */
 typedef void (*cdl_kd_visit)(void *ctx, uint32_t point, float d2);
 uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn, void *ctx);

@@ -1,0 +1,324 @@
+/* pm: photon mapping (Jensen 1996) with the importance sampling
+ * techniques of Keller & Wald 2000.
+ *
+ * Each pass traces fresh photons (transport/photons.c: light subpaths of
+ * the shared tracer, deposited into a global and a caustic map), then one
+ * sample per pixel: the camera ray follows specular surfaces (collecting
+ * emission) to the first non-specular point x, where
+ *   direct light    light sampling (--direct power | lcon | lcon-biased),
+ *   caustics        the caustic map (photons last scattered specularly),
+ *   indirect light  --gather N rays from x by BSDF sampling, each querying
+ *                   both maps where it lands (rays that land on a specular
+ *                   surface carry caustics: they are the caustic map's part);
+ *                   --gather 0 queries the global map at x without its
+ *                   primary photons (direct visualization).
+ * Passes average progressively, so the bias of the density estimate
+ * shrinks only with --photons; the noise with the passes. */
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/log.h"
+#include "integrators/integrator.h"
+#include "transport/light_select.h"
+#include "transport/photons.h"
+
+typedef struct pm_state {
+    const cdl_scene *scene;
+    cdl_options opt;
+    cdl_walk walk;
+    cdl_photon_params pp;
+    cdl_photon_map global, caustic, direct;
+    cdl_irr_map irr;   /* precomputed irradiance for gather rays */
+    cdl_importance imp;
+    int has_imp;
+    float max_r2, lcon_r2;
+    cdl_direct_cfg dcfg;
+    uint32_t traced_pass; /* pass whose photons the maps hold, or UINT32_MAX */
+    /* statistics */
+    cdl_photon_stats last, sum;
+    uint32_t passes;
+    size_t peak_bytes;
+    double t_photons, t_importons;
+    uint64_t lcon_sum, lcon_points;
+} pm_state;
+
+static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
+{
+    double t0 = cdl_time_now();
+    int rc = cdl_photons_trace(st->scene, &st->walk, &st->pp, st->opt.sampler, st->opt.seed, pass,
+                               &st->global, &st->caustic, &st->last, err);
+    if (rc)
+        return rc;
+    cdl_pmap_clear(&st->direct);
+    if (st->dcfg.kind != CDL_DIRECT_POWER) {
+        /* the primary photons on their own, for the L_con ball queries */
+        for (uint32_t i = 0; i < st->global.n && !rc; i++)
+            if (cdl_photon_flags(&st->global.ph[i]) & CDL_PH_PRIMARY)
+                rc = cdl_pmap_append(&st->direct, &st->global.ph[i], 1, err);
+        if (!rc)
+            rc = cdl_pmap_build(&st->direct, err);
+        if (rc)
+            return rc;
+    }
+    if (st->opt.pm.gather && st->opt.pm.precompute) {
+        rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, st->opt.pm.k,
+                           st->max_r2, (cdl_kernel)st->opt.pm.kernel, err);
+        if (rc)
+            return rc;
+    }
+    st->dcfg.direct = &st->direct;
+    st->traced_pass = pass;
+    st->sum.paths += st->last.paths;
+    st->sum.candidates += st->last.candidates;
+    st->sum.rays += st->last.rays;
+    *rays += st->last.rays;
+    size_t bytes = cdl_pmap_bytes(&st->global) + cdl_pmap_bytes(&st->caustic) + cdl_pmap_bytes(&st->direct) +
+                   cdl_irr_bytes(&st->irr);
+    st->peak_bytes = bytes > st->peak_bytes ? bytes : st->peak_bytes;
+    st->t_photons += cdl_time_now() - t0;
+    return 0;
+}
+
+static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
+{
+    pm_state *st = self;
+    st->scene = scene;
+    st->opt = *opt;
+    st->walk.maxdepth = opt->maxdepth;
+    st->walk.rr_depth = opt->rr_depth;
+    st->traced_pass = UINT32_MAX;
+    cdl_pmap_init(&st->global);
+    cdl_pmap_init(&st->caustic);
+    cdl_pmap_init(&st->direct);
+    float diag = cdl_length(cdl_sub(scene->bmax, scene->bmin));
+    float r = opt->pm.max_radius > 0.0f ? opt->pm.max_radius : 0.05f * diag;
+    if (!(r > 0.0f))
+        return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "the scene has no extent to size photon queries by");
+    st->max_r2 = r * r;
+    float rl = opt->pm.lcon_radius > 0.0f ? opt->pm.lcon_radius : r;
+    st->lcon_r2 = rl * rl;
+    if (opt->pm.k < 1 || opt->pm.k > 4096)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--knn", 0, "must be in [1, 4096]");
+    if (!(opt->pm.caustic_ratio > 0.0f && opt->pm.caustic_ratio <= 1.0f))
+        return cdl_error_set(err, CDL_ERR_USAGE, "--caustic-ratio", 0, "must be in (0, 1]");
+    if (!(opt->pm.eps >= 0.0f && opt->pm.eps <= 1.0f))
+        return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in [0, 1]");
+    st->dcfg.kind = (cdl_direct_kind)opt->pm.direct;
+    st->dcfg.shadow_rays = opt->pm.shadow_rays ? opt->pm.shadow_rays : 1;
+    st->dcfg.r2 = st->lcon_r2;
+    st->dcfg.direct = &st->direct;
+    st->pp.target = opt->pm.photons;
+    st->pp.q = opt->pm.caustic_ratio;
+    st->pp.caustic_random = opt->pm.caustic_random;
+    st->pp.eps = opt->pm.eps;
+    st->pp.discard = opt->pm.discard;
+    st->pp.max_paths = opt->pm.max_paths ? opt->pm.max_paths : (uint64_t)opt->pm.photons * 1000u;
+    if (st->pp.max_paths < (1u << 20))
+        st->pp.max_paths = 1u << 20;
+    if (opt->pm.importance) {
+        double t0 = cdl_time_now();
+        int rc = cdl_importance_build(&st->imp, scene, &opt->camera, &st->walk, opt->pm.importons, 1024, r,
+                                      opt->sampler, opt->seed, err);
+        if (rc)
+            return rc;
+        st->has_imp = 1;
+        st->pp.imp = &st->imp;
+        st->t_importons = cdl_time_now() - t0;
+    }
+    /* pass 0's photons now, so that a budget that cannot be met is an error before rendering */
+    uint64_t rays = 0;
+    return trace(st, 0, &rays, err);
+}
+
+typedef struct scratch {
+    cdl_pm_query qg, qc;
+    cdl_lcon_scratch lc;
+} scratch;
+
+/* Radiance leaving the non-specular surface point of sf towards wo, from
+ * both maps (at the end of a gather ray). */
+static cdl_vec3 photon_radiance(const pm_state *st, scratch *w, const cdl_surface *sf, const cdl_bsdf *b,
+                                cdl_vec3 wo)
+{
+    cdl_vec3 L = cdl_pmap_radiance(&st->global, &w->qg, sf->p, wo, b);
+    if (st->caustic.n)
+        L = cdl_add(L, cdl_pmap_radiance(&st->caustic, &w->qc, sf->p, wo, b));
+    return L;
+}
+
+static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_sampler *smp, uint64_t *rays,
+                         uint32_t *nlcon)
+{
+    const cdl_scene *s = st->scene;
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f), beta = cdl_v3(1.0f, 1.0f, 1.0f);
+    for (int depth = 0;; depth++) {
+        cdl_hit h;
+        (*rays)++;
+        if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
+            if (s->env_light >= 0)
+                L = cdl_add(L, cdl_mul(beta, s->lights[s->env_light].L));
+            return L;
+        }
+        cdl_surface sf;
+        cdl_surface_at(s, &h, &sf);
+        cdl_bsdf b;
+        cdl_scene_bsdf(s, &sf, &b);
+        cdl_vec3 wo = cdl_neg(d);
+        if (sf.light >= 0)
+            L = cdl_add(L, cdl_mul(beta, cdl_light_Le(&s->lights[sf.light], sf.ng, wo)));
+        if (cdl_bsdf_is_delta(&b)) {
+            if (depth >= st->opt.maxdepth)
+                return L;
+            cdl_scatter sc;
+            float u0 = cdl_sampler_1d(smp), u1, u2;
+            cdl_sampler_2d(smp, &u1, &u2);
+            if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc))
+                return L;
+            beta = cdl_mul(beta, sc.weight);
+            if (cdl_is_black(beta))
+                return L;
+            o = cdl_offset(s, sf.p, sf.ng, sc.wi);
+            d = sc.wi;
+            continue;
+        }
+        if (depth >= st->opt.maxdepth)
+            return L;
+        cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
+        if (depth + 1 < st->opt.maxdepth) {
+            if (st->caustic.n)
+                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qc, sf.p, wo, &b));
+            uint32_t ng = st->opt.pm.gather;
+            if (!ng) {
+                cdl_pm_query q = w->qg;
+                q.skip = CDL_PH_PRIMARY; /* light sampling has the direct part */
+                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b));
+            }
+            cdl_vec3 Lg = cdl_v3(0.0f, 0.0f, 0.0f);
+            for (uint32_t g = 0; g < ng; g++) {
+                cdl_scatter sc;
+                float u0 = cdl_sampler_1d(smp), u1, u2;
+                cdl_sampler_2d(smp, &u1, &u2);
+                if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc) || cdl_is_black(sc.weight))
+                    continue;
+                cdl_hit hg;
+                (*rays)++;
+                if (!cdl_intersect(s, cdl_offset(s, sf.p, sf.ng, sc.wi), sc.wi, FLT_MAX, &hg))
+                    continue; /* the sky is direct light */
+                cdl_surface sg;
+                cdl_surface_at(s, &hg, &sg);
+                cdl_bsdf bg;
+                cdl_scene_bsdf(s, &sg, &bg);
+                if (cdl_bsdf_is_delta(&bg))
+                    continue; /* specular then x: the caustic map's paths */
+                cdl_vec3 wg = cdl_neg(sc.wi);
+                int found = 0;
+                if (bg.type == CDL_MAT_DIFFUSE && st->irr.n) {
+                    cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
+                    cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, &found);
+                    if (found)
+                        Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
+                }
+                if (!found)
+                    Lg = cdl_add(Lg, cdl_mul(sc.weight, photon_radiance(st, w, &sg, &bg, wg)));
+            }
+            if (ng)
+                Lx = cdl_add(Lx, cdl_scale(Lg, 1.0f / (float)ng));
+        }
+        return cdl_add(L, cdl_mul(beta, Lx));
+    }
+}
+
+static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int y1, uint32_t pass,
+                        uint64_t *rays)
+{
+    pm_state *st = self;
+    const cdl_camera *cam = &st->opt.camera;
+    scratch w;
+    uint32_t k = st->opt.pm.k;
+    w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * k),
+                          malloc(sizeof(float) * k)};
+    w.qc = w.qg;
+    uint64_t bad = 0, lsum = 0, lpts = 0;
+    if (w.qg.idx && w.qg.d2 && !cdl_lcon_scratch_init(&w.lc, st->scene->nlights)) {
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                cdl_sampler smp;
+                float jx, jy;
+                cdl_sampler_start(&smp, st->opt.sampler, st->opt.seed,
+                                  (uint64_t)y * (uint64_t)film->width + (uint64_t)x, pass);
+                cdl_sampler_2d(&smp, &jx, &jy);
+                uint32_t nl = 0;
+                cdl_vec3 L = radiance(st, &w, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
+                                      &smp, rays, &nl);
+                lsum += nl;
+                lpts++;
+                bad += (uint64_t)cdl_film_add(film, x, y, L);
+            }
+        cdl_lcon_scratch_free(&w.lc);
+    }
+    free(w.qg.idx);
+    free(w.qg.d2);
+#pragma omp atomic
+    st->lcon_sum += lsum;
+#pragma omp atomic
+    st->lcon_points += lpts;
+    return bad;
+}
+
+static int pm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+{
+    pm_state *st = self;
+    if (st->traced_pass != pass) {
+        int rc = trace(st, pass, &film->rays, err);
+        if (rc)
+            return rc;
+    }
+    st->passes++;
+    cdl_render_tiles(self, film, pass, pm_tile);
+    return 0;
+}
+
+static void pm_report(const void *self)
+{
+    const pm_state *st = self;
+    if (cdl_log_quiet)
+        return;
+    double mib = 1.0 / (1024.0 * 1024.0);
+    printf("pm: per pass %llu photon paths traced (%llu for the global map), %u global + %u caustic "
+           "photons stored of %llu surface hits; maps %.2f MiB (peak, %zu B per photon + kd-tree)\n",
+           (unsigned long long)st->last.paths, (unsigned long long)st->last.paths_global, st->global.n,
+           st->caustic.n, (unsigned long long)st->last.candidates, (double)st->peak_bytes * mib,
+           sizeof(cdl_photon));
+    printf("pm: photon tracing %.2f s over %u passes", st->t_photons, st->passes);
+    if (st->has_imp)
+        printf("; %u importons from %llu paths (%.2f MiB, %.2f s), f = %.4g from %u test rays", st->imp.n,
+               (unsigned long long)st->imp.paths, (double)cdl_importance_bytes(&st->imp) * mib,
+               st->t_importons, st->imp.f, st->imp.tests);
+    if (st->dcfg.kind != CDL_DIRECT_POWER && st->lcon_points)
+        printf("; |L_con| %.2f on average of %u lights", (double)st->lcon_sum / (double)st->lcon_points,
+               st->scene->nlights);
+    printf("\n");
+}
+
+static void pm_destroy(void *self)
+{
+    pm_state *st = self;
+    cdl_pmap_free(&st->global);
+    cdl_pmap_free(&st->caustic);
+    cdl_pmap_free(&st->direct);
+    cdl_irr_free(&st->irr);
+    if (st->has_imp)
+        cdl_importance_free(&st->imp);
+}
+
+const cdl_integrator_vtbl cdl_pm_integrator = {
+    .name = "pm",
+    .summary = "photon mapping with importons, automatic caustics and L_con (Keller & Wald 2000)",
+    .prepare = pm_prepare,
+    .render_pass = pm_render_pass,
+    .destroy = pm_destroy,
+    .report = pm_report,
+    .self_size = sizeof(pm_state),
+};

@@ -1,0 +1,242 @@
+#include "spatial/photon_map.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Octahedral map of the unit sphere to [-1, 1]^2: uniform precision,
+ * 15 bits per coordinate are better than 0.01 degrees. */
+uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits)
+{
+    float s = fabsf(d.x) + fabsf(d.y) + fabsf(d.z);
+    float u = s > 0.0f ? d.x / s : 0.0f, v = s > 0.0f ? d.y / s : 0.0f;
+    if (d.z < 0.0f) {
+        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+        u = pu;
+        v = pv;
+    }
+    float m = (float)((1u << bits) - 1u);
+    uint32_t a = (uint32_t)lrintf((u * 0.5f + 0.5f) * m);
+    uint32_t b = (uint32_t)lrintf((v * 0.5f + 0.5f) * m);
+    return a << bits | b;
+}
+
+cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits)
+{
+    uint32_t mask = (1u << bits) - 1u;
+    float m = (float)mask;
+    float u = (float)((e >> bits) & mask) / m * 2.0f - 1.0f;
+    float v = (float)(e & mask) / m * 2.0f - 1.0f;
+    float z = 1.0f - fabsf(u) - fabsf(v);
+    if (z < 0.0f) {
+        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+        u = pu;
+        v = pv;
+    }
+    return cdl_normalize(cdl_v3(u, v, z));
+}
+
+void cdl_pmap_init(cdl_photon_map *m) { memset(m, 0, sizeof *m); }
+
+void cdl_pmap_free(cdl_photon_map *m)
+{
+    cdl_kd_free(&m->kd);
+    free(m->ph);
+    memset(m, 0, sizeof *m);
+}
+
+void cdl_pmap_clear(cdl_photon_map *m)
+{
+    cdl_kd_free(&m->kd);
+    m->n = 0;
+    m->built = 0;
+}
+
+int cdl_pmap_append(cdl_photon_map *m, const cdl_photon *ph, uint32_t n, cdl_error *err)
+{
+    if ((uint64_t)m->n + n > UINT32_MAX / 2)
+        return cdl_error_set(err, CDL_ERR_INPUT, "photon map", 0, "more than 2^31 photons");
+    if (m->n + n > m->cap) {
+        uint32_t cap = m->cap ? m->cap : 1024;
+        while (cap < m->n + n)
+            cap = cap > UINT32_MAX / 4 ? m->n + n : cap * 2;
+        cdl_photon *p = realloc(m->ph, sizeof(cdl_photon) * cap);
+        if (!p)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory for %u photons", cap);
+        m->ph = p;
+        m->cap = cap;
+    }
+    memcpy(m->ph + m->n, ph, sizeof(cdl_photon) * n);
+    m->n += n;
+    m->built = 0;
+    return 0;
+}
+
+void cdl_pmap_scale(cdl_photon_map *m, float s)
+{
+    for (uint32_t i = 0; i < m->n; i++)
+        for (int c = 0; c < 3; c++)
+            m->ph[i].power[c] *= s;
+}
+
+int cdl_pmap_build(cdl_photon_map *m, cdl_error *err)
+{
+    cdl_kd_free(&m->kd);
+    int rc = cdl_kd_build(&m->kd, m->n ? m->ph[0].p : NULL, sizeof(cdl_photon) / sizeof(float), m->n, err);
+    if (rc)
+        return rc;
+    /* photons in tree order: a query touches neighbouring memory */
+    cdl_photon *sorted = malloc(sizeof(cdl_photon) * (m->cap ? m->cap : 1));
+    if (!sorted)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory");
+    for (uint32_t i = 0; i < m->n; i++)
+        sorted[i] = m->ph[m->kd.idx[i]];
+    free(m->ph);
+    m->ph = sorted;
+    m->kd.pts = m->n ? m->ph[0].p : NULL;
+    cdl_kd_make_identity(&m->kd);
+    m->built = 1;
+    return 0;
+}
+
+size_t cdl_pmap_bytes(const cdl_photon_map *m) { return (size_t)m->n * sizeof(cdl_photon) + cdl_kd_bytes(&m->kd); }
+
+/* Kernel weight at squared distance d2 in a disc of squared radius r2,
+ * and the kernel's integral over that disc (pi r^2, pi r^2 / 3, pi r^2 / 2). */
+static float kernel_w(cdl_kernel k, float d2, float r2)
+{
+    if (k == CDL_KERNEL_CONE)
+        return 1.0f - sqrtf(d2 / r2);
+    if (k == CDL_KERNEL_EPANECHNIKOV)
+        return 1.0f - d2 / r2;
+    return 1.0f;
+}
+
+static float kernel_area(cdl_kernel k, float r2)
+{
+    float a = CDL_PI * r2;
+    return k == CDL_KERNEL_CONE ? a / 3.0f : k == CDL_KERNEL_EPANECHNIKOV ? a * 0.5f : a;
+}
+
+/* The k nearest within the maximum radius (as a heap) and the radius of
+ * the estimate: the k-th distance, or the maximum with fewer than k. */
+static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, float *r2)
+{
+    if (!m->n || !m->built)
+        return 0;
+    uint32_t n = cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
+    *r2 = n == q->k ? q->d2[0] : q->max_r2;
+    return *r2 > 0.0f ? n : 0;
+}
+
+cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 wo,
+                           const cdl_bsdf *b)
+{
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    float r2;
+    uint32_t n = gather(m, q, x, &r2);
+    for (uint32_t i = 0; i < n; i++) {
+        const cdl_photon *ph = &m->ph[q->idx[i]];
+        if (cdl_photon_flags(ph) & q->skip)
+            continue;
+        cdl_vec3 f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
+        if (cdl_is_black(f))
+            continue;
+        float w = kernel_w(q->kernel, q->d2[i], r2);
+        L = cdl_add(L, cdl_scale(cdl_mul(f, cdl_v3(ph->power[0], ph->power[1], ph->power[2])), w));
+    }
+    return n ? cdl_scale(L, 1.0f / kernel_area(q->kernel, r2)) : L;
+}
+
+cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nrm)
+{
+    cdl_vec3 E = cdl_v3(0.0f, 0.0f, 0.0f);
+    float r2;
+    uint32_t n = gather(m, q, x, &r2);
+    for (uint32_t i = 0; i < n; i++) {
+        const cdl_photon *ph = &m->ph[q->idx[i]];
+        if ((cdl_photon_flags(ph) & q->skip) || cdl_dot(cdl_photon_n(ph), nrm) < 0.5f ||
+            cdl_dot(cdl_photon_wi(ph), nrm) <= 0.0f)
+            continue;
+        float w = kernel_w(q->kernel, q->d2[i], r2);
+        E = cdl_add(E, cdl_scale(cdl_v3(ph->power[0], ph->power[1], ph->power[2]), w));
+    }
+    return n ? cdl_scale(E, 1.0f / kernel_area(q->kernel, r2)) : E;
+}
+
+int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
+                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_error *err)
+{
+    cdl_irr_free(im);
+    every = every ? every : 1;
+    uint32_t n = (global->n + every - 1) / every;
+    im->pt = malloc(sizeof(cdl_irr_point) * (n ? n : 1));
+    if (!im->pt)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory for %u irradiance points", n);
+    int fail = 0;
+#pragma omp parallel
+    {
+        uint32_t *idx = malloc(sizeof(uint32_t) * k);
+        float *d2 = malloc(sizeof(float) * k);
+        cdl_pm_query q = {k, max_r2, kernel, 0, idx, d2};
+        if (!idx || !d2) {
+#pragma omp atomic write
+            fail = 1;
+        }
+#pragma omp for schedule(dynamic, 256)
+        for (int64_t i = 0; i < (int64_t)n; i++) {
+            if (!idx || !d2)
+                continue;
+            const cdl_photon *ph = &global->ph[(size_t)i * every];
+            cdl_vec3 x = cdl_v3(ph->p[0], ph->p[1], ph->p[2]), nrm = cdl_photon_n(ph);
+            cdl_vec3 E = cdl_pmap_irradiance(global, &q, x, nrm);
+            if (caustic->n)
+                E = cdl_add(E, cdl_pmap_irradiance(caustic, &q, x, nrm));
+            cdl_irr_point *p = &im->pt[i];
+            memcpy(p->p, ph->p, sizeof p->p);
+            p->E[0] = E.x;
+            p->E[1] = E.y;
+            p->E[2] = E.z;
+            p->n = cdl_oct_encode_bits(nrm, 16);
+        }
+        free(idx);
+        free(d2);
+    }
+    im->n = n;
+    if (fail) {
+        cdl_irr_free(im);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory");
+    }
+    if (cdl_kd_build(&im->kd, n ? im->pt[0].p : NULL, sizeof(cdl_irr_point) / sizeof(float), n, err)) {
+        cdl_irr_free(im);
+        return err->code;
+    }
+    return 0;
+}
+
+void cdl_irr_free(cdl_irr_map *im)
+{
+    cdl_kd_free(&im->kd);
+    free(im->pt);
+    memset(im, 0, sizeof *im);
+}
+
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, int *found)
+{
+    uint32_t idx[8];
+    float d2[8];
+    *found = 0;
+    if (!im->n)
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    uint32_t m = cdl_kd_knn(&im->kd, x, 8, max_r2, idx, d2);
+    for (uint32_t i = 0; i < m; i++) {
+        const cdl_irr_point *p = &im->pt[idx[i]];
+        if (cdl_dot(cdl_oct_decode_bits(p->n, 16), n) > 0.9f) {
+            *found = 1;
+            return cdl_v3(p->E[0], p->E[1], p->E[2]);
+        }
+    }
+    return cdl_v3(0.0f, 0.0f, 0.0f);
+}

@@ -1,0 +1,108 @@
+/* Photon maps (Jensen 1996): stored photons in a balanced kd-tree and the
+ * density estimate of reflected radiance over the k nearest. Photons come
+ * from the shared light-subpath tracer (transport/photons.c); this file
+ * only stores and queries them. */
+#ifndef CDL_PHOTON_MAP_H
+#define CDL_PHOTON_MAP_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+#include "scene/bsdf.h"
+#include "spatial/pointkd.h"
+
+enum {
+    CDL_PH_PRIMARY = 1, /* came straight from its light (Keller & Wald §3 keep its id) */
+    CDL_PH_CAUSTIC = 2  /* last scattered by a specular surface */
+};
+
+/* 32 bytes: position, flux, incoming direction (octahedral, 2 x 15 bits)
+ * with two flag bits, surface normal (octahedral, 2 x 8 bits) and the
+ * index of the photon's light (0xffff past 65534 lights). */
+typedef struct cdl_photon {
+    float p[3];
+    float power[3];
+    uint32_t wi;     /* towards where the photon came from | flags << 30 */
+    uint16_t n;      /* geometric normal on the side the photon arrived from */
+    uint16_t light;
+} cdl_photon;
+
+#define CDL_PH_NO_LIGHT 0xffffu
+static inline uint32_t cdl_photon_light(const cdl_photon *ph) { return ph->light; }
+static inline uint32_t cdl_photon_flags(const cdl_photon *ph) { return ph->wi >> 30; }
+
+/* Octahedral encoding (Meyer et al. 2010) with `bits` per coordinate. */
+uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits);
+cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits);
+static inline cdl_vec3 cdl_photon_wi(const cdl_photon *ph) { return cdl_oct_decode_bits(ph->wi & 0x3fffffffu, 15); }
+static inline cdl_vec3 cdl_photon_n(const cdl_photon *ph) { return cdl_oct_decode_bits(ph->n, 8); }
+
+
+typedef struct cdl_photon_map {
+    cdl_photon *ph;
+    uint32_t n, cap;
+    cdl_kdtree kd;
+    int built;
+} cdl_photon_map;
+
+typedef enum { CDL_KERNEL_BOX, CDL_KERNEL_CONE, CDL_KERNEL_EPANECHNIKOV } cdl_kernel;
+
+void cdl_pmap_init(cdl_photon_map *m);
+void cdl_pmap_free(cdl_photon_map *m);
+void cdl_pmap_clear(cdl_photon_map *m); /* keeps the memory */
+int cdl_pmap_append(cdl_photon_map *m, const cdl_photon *ph, uint32_t n, cdl_error *err);
+/* Multiplies every stored flux by s (normalization by the number of paths). */
+void cdl_pmap_scale(cdl_photon_map *m, float s);
+int cdl_pmap_build(cdl_photon_map *m, cdl_error *err);
+size_t cdl_pmap_bytes(const cdl_photon_map *m);
+
+/* A radiance query: k nearest within max_r2; photons with any of the
+ * skip flags are left out of the sum (but still fix the radius, so the
+ * estimate is that of the remaining subset). scratch must hold k. */
+typedef struct cdl_pm_query {
+    uint32_t k;
+    float max_r2;
+    cdl_kernel kernel;
+    uint32_t skip;
+    uint32_t *idx;
+    float *d2;
+} cdl_pm_query;
+
+/* Reflected radiance at x towards wo: sum of f(wo, wi_p) flux_p w(d_p)
+ * over the nearest photons, divided by the kernel's area. */
+cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 wo,
+                           const cdl_bsdf *b);
+
+
+/* Precomputed irradiance (Christensen 1999): the irradiance from both
+ * maps at every m-th global photon, so that a final-gathering ray that
+ * lands on a Lambertian surface costs one small lookup instead of a
+ * k-nearest density estimate. */
+typedef struct cdl_irr_point {
+    float p[3];
+    float E[3];
+    uint32_t n; /* octahedral normal, 2 x 16 bits */
+} cdl_irr_point;
+
+typedef struct cdl_irr_map {
+    cdl_irr_point *pt;
+    uint32_t n;
+    cdl_kdtree kd;
+} cdl_irr_map;
+
+/* Irradiance at x on a surface with normal n from the photons of m
+ * arriving from n's side (photons of surfaces facing elsewhere left out). */
+cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 n);
+int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
+                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_error *err);
+void cdl_irr_free(cdl_irr_map *im);
+/* Irradiance of the nearest point within sqrt(max_r2) whose normal is
+ * within about 25 degrees of n; 0 if there is none (*found = 0). */
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, int *found);
+static inline size_t cdl_irr_bytes(const cdl_irr_map *im)
+{
+    return (size_t)im->n * sizeof(cdl_irr_point) + cdl_kd_bytes(&im->kd);
+}
+
+#endif

@@ -1,0 +1,151 @@
+#include "transport/light_select.h"
+
+#include <float.h>
+#include <stdlib.h>
+
+int cdl_lcon_scratch_init(cdl_lcon_scratch *sc, uint32_t nlights)
+{
+    sc->mark = calloc(nlights ? nlights : 1, 1);
+    sc->ids = malloc(sizeof(uint32_t) * (nlights ? nlights : 1));
+    if (sc->mark && sc->ids)
+        return 0;
+    cdl_lcon_scratch_free(sc);
+    return -1;
+}
+
+void cdl_lcon_scratch_free(cdl_lcon_scratch *sc)
+{
+    free(sc->mark);
+    free(sc->ids);
+    sc->mark = NULL;
+    sc->ids = NULL;
+}
+
+typedef struct lcon_ctx {
+    const cdl_photon_map *m;
+    cdl_lcon_scratch *sc;
+    uint32_t n;
+} lcon_ctx;
+
+static void visit(void *ctx, uint32_t point, float d2)
+{
+    (void)d2;
+    lcon_ctx *c = ctx;
+    uint32_t l = cdl_photon_light(&c->m->ph[point]);
+    if (l != CDL_PH_NO_LIGHT && !c->sc->mark[l]) {
+        c->sc->mark[l] = 1;
+        c->sc->ids[c->n++] = l;
+    }
+}
+
+uint32_t cdl_lcon_query(const cdl_scene *s, const cdl_photon_map *direct, cdl_vec3 x, float r2,
+                        cdl_lcon_scratch *sc)
+{
+    lcon_ctx c = {direct, sc, 0};
+    for (uint32_t l = 0; l < s->nlights; l++)
+        if (s->lights[l].type == CDL_LIGHT_DISTANT || s->lights[l].type == CDL_LIGHT_INFINITE ||
+            l >= CDL_PH_NO_LIGHT) {
+            sc->mark[l] = 1;
+            sc->ids[c.n++] = l;
+        }
+    if (direct->n && direct->built)
+        cdl_kd_ball(&direct->kd, x, r2, visit, &c);
+    for (uint32_t i = 0; i < c.n; i++)
+        sc->mark[sc->ids[i]] = 0;
+    /* insertion sort: L_con is small, and the rest is indexed through it */
+    for (uint32_t i = 1; i < c.n; i++) {
+        uint32_t v = sc->ids[i], j = i;
+        for (; j > 0 && sc->ids[j - 1] > v; j--)
+            sc->ids[j] = sc->ids[j - 1];
+        sc->ids[j] = v;
+    }
+    return c.n;
+}
+
+/* f L cos / pdf of one point on light l (one shadow ray), not divided by
+ * the light's selection probability. */
+static cdl_vec3 sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf, const cdl_bsdf *b,
+                             cdl_vec3 wo, cdl_sampler *smp, uint64_t *rays)
+{
+    const cdl_light *l = &s->lights[li];
+    float u1, u2;
+    cdl_sampler_2d(smp, &u1, &u2);
+    cdl_light_sample ls;
+    if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls) || !(ls.pdf > 0.0f))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
+    if (cdl_is_black(f))
+        return f;
+    cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
+    (*rays)++;
+    uint32_t skip = l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
+    if (cdl_occluded_skip(s, o, ls.wi, ls.dist < FLT_MAX ? ls.dist * (1.0f - 1e-4f) : FLT_MAX, skip))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
+    return cdl_scale(cdl_mul(f, ls.Li), cos / ls.pdf);
+}
+
+cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lcon_scratch *sc,
+                          const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo, cdl_sampler *smp,
+                          uint64_t *rays, uint32_t *nlcon)
+{
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    uint32_t S = cfg->shadow_rays ? cfg->shadow_rays : 1;
+    *nlcon = 0;
+    if (!s->nlights)
+        return L;
+    if (cfg->kind == CDL_DIRECT_POWER) {
+        for (uint32_t i = 0; i < S; i++) {
+            float us, ua, pmf;
+            cdl_sampler_2d(smp, &us, &ua);
+            uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
+            if (pmf > 0.0f)
+                L = cdl_add(L, cdl_scale(sample_light(s, li, sf, b, wo, smp, rays), 1.0f / pmf));
+        }
+        return cdl_scale(L, 1.0f / (float)S);
+    }
+    uint32_t n = cdl_lcon_query(s, cfg->direct, sf->p, cfg->r2, sc);
+    *nlcon = n;
+    const float *pw = s->light_select.pmf;
+    float W = 0.0f;
+    for (uint32_t j = 0; j < n; j++)
+        W += pw[sc->ids[j]];
+    if (n && W > 0.0f) {
+        if (S >= n) {
+            /* every light of L_con gets n_j >= 1 rays, about S in proportion to power */
+            for (uint32_t j = 0; j < n; j++) {
+                uint32_t nj = (uint32_t)((float)S * pw[sc->ids[j]] / W + 0.5f);
+                nj = nj ? nj : 1;
+                cdl_vec3 Lj = cdl_v3(0.0f, 0.0f, 0.0f);
+                for (uint32_t r = 0; r < nj; r++)
+                    Lj = cdl_add(Lj, sample_light(s, sc->ids[j], sf, b, wo, smp, rays));
+                L = cdl_add(L, cdl_scale(Lj, 1.0f / (float)nj));
+            }
+        } else {
+            /* fewer rays than lights: S lights drawn in proportion to power */
+            for (uint32_t r = 0; r < S; r++) {
+                float u = cdl_sampler_1d(smp) * W, acc = 0.0f;
+                uint32_t j = 0;
+                for (; j + 1 < n; j++) {
+                    acc += pw[sc->ids[j]];
+                    if (u < acc)
+                        break;
+                }
+                float pmf = pw[sc->ids[j]] / W;
+                if (pmf > 0.0f)
+                    L = cdl_add(L, cdl_scale(sample_light(s, sc->ids[j], sf, b, wo, smp, rays),
+                                             1.0f / (pmf * (float)S)));
+            }
+        }
+    }
+    uint32_t rest = s->nlights - n;
+    if (cfg->kind == CDL_DIRECT_LCON && rest) {
+        /* one ray to a uniformly chosen light outside L_con, scaled by |rest| */
+        uint32_t r = (uint32_t)(cdl_sampler_1d(smp) * (float)rest);
+        r = r < rest ? r : rest - 1;
+        for (uint32_t j = 0; j < n && sc->ids[j] <= r; j++)
+            r++; /* the r-th index not in the sorted L_con */
+        L = cdl_add(L, cdl_scale(sample_light(s, r, sf, b, wo, smp, rays), (float)rest));
+    }
+    return L;
+}

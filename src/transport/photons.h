@@ -1,0 +1,48 @@
+/* Photon tracing for the photon map (Jensen 1996) with the deposition
+ * control of Keller & Wald 2000: photons are the vertices of light
+ * subpaths from the shared tracer, stored in a caustic map (last bounce
+ * specular) or the global map, each with a probability:
+ *
+ *   caustic photon:   stored with p(x),      flux L / p(x)
+ *   other photons:    stored with q p(x),    flux L / (q p(x))      (random)
+ *                     or, for the first floor(q N) paths only, with p(x)  (prefix)
+ *
+ * p(x) = min(1, f I(x)) from the importon map (1 without one); bounded
+ * below by eps (unbiased) or, with discard, photons below eps are dropped
+ * (biased). Paths are traced until the global map holds `target`
+ * photons; then, in prefix mode, paths floor(q N) + 1 .. N fill the
+ * caustic map only (§2.3). Deterministic per (seed, pass) on any number
+ * of threads: paths are seeded by their index and kept in index order. */
+#ifndef CDL_PHOTONS_H
+#define CDL_PHOTONS_H
+
+#include "spatial/photon_map.h"
+#include "transport/importance.h"
+#include "transport/subpath.h"
+
+typedef struct cdl_photon_params {
+    uint32_t target;            /* global photons to store */
+    float q;                    /* caustic ratio, (0, 1] */
+    int caustic_random;         /* per-photon test against q instead of the path prefix */
+    const cdl_importance *imp;  /* NULL: p = 1 */
+    float eps;                  /* lower bound of p */
+    int discard;                /* drop photons with p < eps instead (biased) */
+    uint64_t max_paths;         /* give up beyond this many paths */
+} cdl_photon_params;
+
+typedef struct cdl_photon_stats {
+    uint64_t paths;         /* light paths traced in all */
+    uint64_t paths_global;  /* of which filled the global map */
+    uint64_t candidates;    /* non-specular surface hits (photons before deposition) */
+    uint64_t rays;
+} cdl_photon_stats;
+
+/* Fills both maps (cleared first) and builds their kd-trees. */
+int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon_params *pp,
+                      cdl_sampler_kind kind, uint64_t seed, uint32_t pass, cdl_photon_map *global,
+                      cdl_photon_map *caustic, cdl_photon_stats *st, cdl_error *err);
+
+/* Whether material m scatters specularly (its photons are caustic photons). */
+int cdl_photons_specular(const cdl_scene *s, uint32_t mat);
+
+#endif
