@@ -405,6 +405,9 @@ int cdl_cmd_render(int argc, char **argv)
     cdl_film film = {0};
     cdl_image img = {0};
     rc = cdl_render_setup(&a, &scene, &set, &opt, defout, sizeof defout, &err);
+    t_load = cdl_time_now() - t_load;
+    /* a method's preprocessing (photons, importons) is part of its render time */
+    double t0 = cdl_time_now();
     if (!rc)
         rc = cdl_integrator_create(a.integrator, &integ, &err);
     if (!rc)
@@ -425,18 +428,17 @@ int cdl_cmd_render(int argc, char **argv)
         cdl_scene_free(&scene);
         return status;
     }
-    t_load = cdl_time_now() - t_load;
 
     signal(SIGINT, on_sigint);
     cdl_progress prog;
     cdl_progress_begin(&prog);
-    double t0 = cdl_time_now();
     uint32_t pass = 0;
     int pass_failed = 0;
     char label[64];
+    double t_loop = cdl_time_now();
     for (;;) {
-        double el = cdl_time_now() - t0;
-        if (a.spp ? pass >= (uint32_t)a.spp : (pass > 0 && el + el / pass > a.time))
+        double now = cdl_time_now(), el = now - t0;
+        if (a.spp ? pass >= (uint32_t)a.spp : (pass > 0 && el + (now - t_loop) / pass > a.time))
             break;
         if (cdl_cancel)
             break;
