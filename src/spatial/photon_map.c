@@ -213,6 +213,17 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
         cdl_irr_free(im);
         return err->code;
     }
+    cdl_irr_point *sorted = malloc(sizeof(cdl_irr_point) * (n ? n : 1));
+    if (!sorted) {
+        cdl_irr_free(im);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory");
+    }
+    for (uint32_t i = 0; i < n; i++)
+        sorted[i] = im->pt[im->kd.idx[i]];
+    free(im->pt);
+    im->pt = sorted;
+    im->kd.pts = n ? im->pt[0].p : NULL;
+    cdl_kd_make_identity(&im->kd);
     return 0;
 }
 

@@ -88,6 +88,7 @@ void cdl_kd_make_identity(cdl_kdtree *t)
 {
     for (uint32_t i = 0; i < t->n; i++)
         t->idx[i] = i;
+    t->identity = 1;
 }
 
 void cdl_kd_free(cdl_kdtree *t)
@@ -161,7 +162,7 @@ static void heap_push(knn *h, uint32_t i, float d)
 static void knn_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, knn *h)
 {
     while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2, p = t->idx[mid];
+        uint32_t mid = lo + (hi - lo) / 2, p = t->identity ? mid : t->idx[mid];
         float d = dist2(t, p, q);
         if (d <= h->r2)
             heap_push(h, p, d);
@@ -211,7 +212,7 @@ static uint32_t ball_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_v
 {
     uint32_t count = 0;
     while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2, p = t->idx[mid];
+        uint32_t mid = lo + (hi - lo) / 2, p = t->identity ? mid : t->idx[mid];
         float d = dist2(t, p, q);
         if (d <= r2) {
             fn(ctx, p, d);

@@ -18,6 +18,7 @@ typedef struct cdl_kdtree {
     uint8_t *axis;     /* split axis of each tree position */
     const float *pts;  /* point i at pts[i * stride .. + 2] (not owned) */
     uint32_t stride;   /* floats between consecutive points */
+    int identity;      /* idx[i] == i: points are stored in tree order */
 } cdl_kdtree;
 
 /* Builds over n points; pts must outlive the tree. Non-finite points are
