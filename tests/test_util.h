@@ -37,10 +37,10 @@ static inline void render_film(const char *integrator, const cdl_scene *s, const
     cdl_error err;
     cdl_integrator it;
     die_on(cdl_integrator_create(integrator, &it, &err), &err);
-    die_on(it.vt->prepare(it.self, s, opt), &err);
+    die_on(it.vt->prepare(it.self, s, opt, &err), &err);
     die_on(cdl_film_init(film, w, h, &err), &err);
     for (uint32_t p = 0; p < npass; p++)
-        it.vt->render_pass(it.self, film, p);
+        die_on(it.vt->render_pass(it.self, film, p, &err), &err);
     cdl_integrator_destroy(&it);
 }
 
