@@ -115,9 +115,7 @@ int cdl_cmd_photons(int argc, char **argv)
     }
     cdl_photon_params pp = {opt.pm.photons, opt.pm.caustic_ratio, opt.pm.caustic_random,
                             has_imp ? &imp : NULL, opt.pm.eps, opt.pm.discard,
-                            opt.pm.max_paths ? opt.pm.max_paths : (uint64_t)opt.pm.photons * 1000u};
-    if (pp.max_paths < (1u << 20))
-        pp.max_paths = 1u << 20;
+                            opt.pm.max_paths ? opt.pm.max_paths : cdl_photons_default_max_paths(opt.pm.photons)};
     cdl_photon_stats ps;
     if (!rc)
         rc = cdl_photons_trace(&scene, &walk, &pp, opt.sampler, opt.seed, 0, &g, &c, &ps, &err);

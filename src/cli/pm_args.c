@@ -132,6 +132,7 @@ void cdl_pm_args_help(void)
            "      --shadow-rays S     direct-light shadow rays per shading point (default 1)\n"
            "      --lcon-radius R     radius of the L_con query (default: --max-radius)\n"
            "      --photon-paths-max N  give up when N paths per pass have not stored\n"
-           "                          --photons photons (default 1000 per photon)\n"
+           "                          --photons photons (default 1000 per photon, at\n"
+           "                          least 2^20)\n"
            "\n");
 }

@@ -114,9 +114,7 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     st->pp.caustic_random = opt->pm.caustic_random;
     st->pp.eps = opt->pm.eps;
     st->pp.discard = opt->pm.discard;
-    st->pp.max_paths = opt->pm.max_paths ? opt->pm.max_paths : (uint64_t)opt->pm.photons * 1000u;
-    if (st->pp.max_paths < (1u << 20))
-        st->pp.max_paths = 1u << 20;
+    st->pp.max_paths = opt->pm.max_paths ? opt->pm.max_paths : cdl_photons_default_max_paths(opt->pm.photons);
     if (opt->pm.importance) {
         double t0 = cdl_time_now();
         int rc = cdl_importance_build(&st->imp, scene, &opt->camera, &st->walk, opt->pm.importons, 1024, r,
@@ -129,7 +127,14 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     }
     /* pass 0's photons now, so that a budget that cannot be met is an error before rendering */
     uint64_t rays = 0;
-    return trace(st, 0, &rays, err);
+    int rc = trace(st, 0, &rays, err);
+    for (uint32_t i = 0; !rc && i < scene->nlights; i++)
+        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE) {
+            cdl_warn(scene->path, 0, "pm: distant and infinite lights emit no photons yet: their direct "
+                                     "light is sampled, their indirect light is missing");
+            break;
+        }
+    return rc;
 }
 
 typedef struct scratch {

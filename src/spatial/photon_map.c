@@ -56,6 +56,8 @@ void cdl_pmap_clear(cdl_photon_map *m)
 
 int cdl_pmap_append(cdl_photon_map *m, const cdl_photon *ph, uint32_t n, cdl_error *err)
 {
+    if (!n)
+        return 0;
     if ((uint64_t)m->n + n > UINT32_MAX / 2)
         return cdl_error_set(err, CDL_ERR_INPUT, "photon map", 0, "more than 2^31 photons");
     if (m->n + n > m->cap) {
@@ -68,7 +70,8 @@ int cdl_pmap_append(cdl_photon_map *m, const cdl_photon *ph, uint32_t n, cdl_err
         m->ph = p;
         m->cap = cap;
     }
-    memcpy(m->ph + m->n, ph, sizeof(cdl_photon) * n);
+    if (n)
+        memcpy(m->ph + m->n, ph, sizeof(cdl_photon) * n);
     m->n += n;
     m->built = 0;
     return 0;

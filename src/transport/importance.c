@@ -104,7 +104,7 @@ int cdl_importance_build(cdl_importance *imp, const cdl_scene *s, const cdl_came
     if (!fail && (imp->pts = malloc(sizeof(float) * 4 * (total ? total : 1))) == NULL)
         fail = 1;
     for (uint64_t c = 0; c < nchunks; c++) {
-        if (!fail)
+        if (!fail && out[c].n)
             memcpy(imp->pts + 4 * (size_t)imp->n, out[c].pts, sizeof(float) * 4 * out[c].n);
         imp->n += fail ? 0 : out[c].n;
         free(out[c].pts);

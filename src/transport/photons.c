@@ -175,7 +175,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         if (next >= pp->max_paths) {
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                                "photon budget cannot be met: %u photons requested, %u stored after %llu "
-                               "paths (the limit); lower --photons or --importance-eps, or check that "
+                               "paths (the limit, --photon-paths-max); lower --photons, or check that "
                                "the lights reach what the camera sees",
                                pp->target, global->n, (unsigned long long)next);
             break;
@@ -223,17 +223,19 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         if (rate <= 0.0 && next >= (1u << 16)) {
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                                "photon budget cannot be met: no photon stored after %llu paths (do the "
-                               "lights reach any surface%s?)",
-                               (unsigned long long)next, pp->imp ? " the camera sees" : "");
+                               "lights reach any surface%s?%s)",
+                               (unsigned long long)next, pp->imp ? " the camera sees" : "",
+                               pp->caustic_random && cx.q < 1.0f ? " is --caustic-ratio too small?" : "");
             break;
         }
         double need = rate > 0.0 ? (double)(pp->target - global->n) / rate : (double)next * 4.0;
         if (rate > 0.0 && next >= (1u << 16) && (double)next + need > 1.5 * (double)pp->max_paths) {
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                                "photon budget cannot be met: %u photons need about %.3g paths at the "
-                               "rate so far (%.3g stored per path), more than the limit of %llu; lower "
-                               "--photons or raise --importance-eps",
-                               pp->target, (double)next + need, rate, (unsigned long long)pp->max_paths);
+                               "rate so far (%.3g stored per path), more than the limit of %llu "
+                               "(--photon-paths-max); lower --photons%s",
+                               pp->target, (double)next + need, rate, (unsigned long long)pp->max_paths,
+                               pp->imp ? " or raise --importance-eps" : "");
             break;
         }
         batch = (uint64_t)(need * 1.05) + CHUNK;
@@ -241,7 +243,13 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
     uint64_t n1 = next, n = next;
     /* phase 2 (prefix mode): the remaining paths fill only the caustic map */
     if (!rc && !pp->caustic_random && cx.q < 1.0f) {
-        n = (uint64_t)floor((double)n1 / (double)cx.q);
+        double want = floor((double)n1 / (double)cx.q);
+        if (want > (double)pp->max_paths)
+            rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
+                               "photon budget cannot be met: --caustic-ratio %g needs %.3g paths for the "
+                               "caustic map, more than the limit of %llu (--photon-paths-max)",
+                               (double)cx.q, want, (unsigned long long)pp->max_paths);
+        n = rc ? n1 : (uint64_t)want;
         for (uint64_t first = n1; !rc && first < n;) {
             uint64_t nb = n - first < MAX_BATCH ? n - first : MAX_BATCH;
             if (run_batch(&cx, first, nb, 1, bufs)) {

@@ -42,6 +42,13 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
                       cdl_sampler_kind kind, uint64_t seed, uint32_t pass, cdl_photon_map *global,
                       cdl_photon_map *caustic, cdl_photon_stats *st, cdl_error *err);
 
+/* The path limit when none is given: 1000 per photon, at least 2^20. */
+static inline uint64_t cdl_photons_default_max_paths(uint32_t photons)
+{
+    uint64_t m = (uint64_t)photons * 1000u;
+    return m > (1u << 20) ? m : (1u << 20);
+}
+
 /* Whether material m scatters specularly (its photons are caustic photons). */
 int cdl_photons_specular(const cdl_scene *s, uint32_t mat);
 
