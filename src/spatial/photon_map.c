@@ -244,7 +244,13 @@ cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max
     *found = 0;
     if (!im->n)
         return cdl_v3(0.0f, 0.0f, 0.0f);
-    uint32_t m = cdl_kd_knn(&im->kd, x, 8, max_r2, idx, d2);
+    /* the nearest point almost always matches: one cheap 1-NN search first */
+    uint32_t m = cdl_kd_knn(&im->kd, x, 1, max_r2, idx, d2);
+    if (m && cdl_dot(cdl_oct_decode_bits(im->pt[idx[0]].n, 16), n) > 0.9f) {
+        *found = 1;
+        return cdl_v3(im->pt[idx[0]].E[0], im->pt[idx[0]].E[1], im->pt[idx[0]].E[2]);
+    }
+    m = m ? cdl_kd_knn(&im->kd, x, 8, max_r2, idx, d2) : 0;
     for (uint32_t i = 0; i < m; i++) {
         const cdl_irr_point *p = &im->pt[idx[i]];
         if (cdl_dot(cdl_oct_decode_bits(p->n, 16), n) > 0.9f) {

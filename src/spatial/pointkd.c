@@ -162,6 +162,16 @@ static void heap_push(knn *h, uint32_t i, float d)
 static void knn_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, knn *h)
 {
     while (lo < hi) {
+        /* a small subtree is a contiguous range: scanning it beats descending */
+        if (hi - lo <= 16) {
+            for (uint32_t i = lo; i < hi; i++) {
+                uint32_t p = t->identity ? i : t->idx[i];
+                float d = dist2(t, p, q);
+                if (d <= h->r2)
+                    heap_push(h, p, d);
+            }
+            return;
+        }
         uint32_t mid = lo + (hi - lo) / 2, p = t->identity ? mid : t->idx[mid];
         float d = dist2(t, p, q);
         if (d <= h->r2)
