@@ -6,6 +6,7 @@
 #define CDL_SCENE_H
 
 #include <embree3/rtcore.h>
+#include <float.h>
 #include <stdint.h>
 
 #include "core/alias.h"
@@ -205,6 +206,19 @@ static inline cdl_vec3 cdl_offset(const cdl_scene *s, cdl_vec3 p, cdl_vec3 ng, c
     float m = cdl_maxf(fabsf(p.x), cdl_maxf(fabsf(p.y), fabsf(p.z)));
     float e = s->eps + m * 1e-5f;
     return cdl_madd(p, ng, cdl_dot(d, ng) < 0.0f ? -e : e);
+}
+
+/* Length of a shadow ray from cdl_offset(p, ...) towards a light point at
+ * distance dist: shortened by twice the offset as well as relatively, so
+ * that far from the origin (large offsets) it still stops short of the
+ * light's own surface. FLT_MAX stays FLT_MAX (lights at infinity). */
+static inline float cdl_shadow_tmax(const cdl_scene *s, cdl_vec3 p, float dist)
+{
+    if (!(dist < FLT_MAX))
+        return FLT_MAX;
+    float m = cdl_maxf(fabsf(p.x), cdl_maxf(fabsf(p.y), fabsf(p.z))) + dist;
+    float t = dist * (1.0f - 1e-4f) - 2.0f * (s->eps + m * 1e-5f);
+    return t > 0.0f ? t : 0.0f;
 }
 
 #endif

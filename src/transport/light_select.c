@@ -79,7 +79,7 @@ static cdl_vec3 sample_light(const cdl_scene *s, uint32_t li, const cdl_surface 
     cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
     (*rays)++;
     uint32_t skip = l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
-    if (cdl_occluded_skip(s, o, ls.wi, ls.dist < FLT_MAX ? ls.dist * (1.0f - 1e-4f) : FLT_MAX, skip))
+    if (cdl_occluded_skip(s, o, ls.wi, cdl_shadow_tmax(s, sf->p, ls.dist), skip))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
     return cdl_scale(cdl_mul(f, ls.Li), cos / ls.pdf);
