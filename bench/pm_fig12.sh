@@ -59,7 +59,7 @@ depth=16
 # direct light: 32 shadow rays spread over the lights of nearby primary photons
 # (L_con), one to the rest: unbiased and nearly noise-free here, where 99 of the
 # 100 lights are occluded (--direct power with one ray leaves relMSE ~18 per pass)
-direct="--direct lcon --shadow-rays 32"
+direct="--direct lcon --shadow-rays 32 --knn 100 --precompute 4" # the defaults of the first run spelled out
 mkdir -p "$out/pics" "$out/ref" "$out/runs" "$out/scene"
 t_start=$(date +%s)
 

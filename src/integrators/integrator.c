@@ -23,15 +23,15 @@ void cdl_options_default(cdl_options *o)
     o->seed = 1;
     o->mis = CDL_MIS_POWER;
     o->interleave = 1;
-    o->pm.photons = 200000;
-    o->pm.k = 100;
+    o->pm.photons = 100000;
+    o->pm.k = 50;
     o->pm.kernel = 1; /* cone */
-    o->pm.gather = 16;
+    o->pm.gather = 8;
     o->pm.precompute = 4;
     o->pm.importons = 1u << 17;
     o->pm.eps = 0.01f;
     o->pm.caustic_ratio = 1.0f;
-    o->pm.shadow_rays = 1;
+    o->pm.shadow_rays = 4;
 }
 
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)
