@@ -170,7 +170,9 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         return cdl_error_set(err, CDL_ERR_SYSTEM, "photons", 0, "out of memory");
     }
     /* phase 1: paths until the global map is full */
-    uint64_t next = 0, batch = pp->target < CHUNK * 16 ? CHUNK * 16 : pp->target;
+    /* a first quarter to learn the photons per path (often 2-3: a batch of
+     * `target` paths would overshoot), then batches sized by that rate */
+    uint64_t next = 0, batch = pp->target / 4 < CHUNK * 16 ? CHUNK * 16 : pp->target / 4;
     while (!rc && global->n < pp->target) {
         if (next >= pp->max_paths) {
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
