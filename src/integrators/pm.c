@@ -51,9 +51,10 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
                                &st->global, &st->caustic, &st->last, err);
     if (rc)
         return rc;
-    cdl_pmap_clear(&st->direct);
-    if (st->dcfg.kind != CDL_DIRECT_POWER) {
-        /* the primary photons on their own, for the L_con ball queries */
+    if (st->dcfg.kind != CDL_DIRECT_POWER && !st->direct.built) {
+        /* the primary photons of the first pass on their own, for the L_con
+         * ball queries; kept for all passes: L_con then stays the same set at
+         * a point, so each light's samples stay stratified over the passes */
         for (uint32_t i = 0; i < st->global.n && !rc; i++)
             if (cdl_photon_flags(&st->global.ph[i]) & CDL_PH_PRIMARY)
                 rc = cdl_pmap_append(&st->direct, &st->global.ph[i], 1, err);

@@ -104,6 +104,10 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
         }
         return cdl_scale(L, 1.0f / (float)S);
     }
+    /* Fixed sampler dimensions per (light, ray), so that a light's samples
+     * at a pixel form one low-discrepancy sequence over the passes, and
+     * later dimensions start at the same place for every pixel. */
+    uint32_t base = smp->dim, stride = S + 1;
     uint32_t n = cdl_lcon_query(s, cfg->direct, sf->p, cfg->r2, sc);
     *nlcon = n;
     const float *pw = s->light_select.pmf;
@@ -117,13 +121,16 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
                 uint32_t nj = (uint32_t)((float)S * pw[sc->ids[j]] / W + 0.5f);
                 nj = nj ? nj : 1;
                 cdl_vec3 Lj = cdl_v3(0.0f, 0.0f, 0.0f);
-                for (uint32_t r = 0; r < nj; r++)
+                for (uint32_t r = 0; r < nj; r++) {
+                    smp->dim = base + 2 + sc->ids[j] * stride + (r < stride ? r : stride - 1);
                     Lj = cdl_add(Lj, sample_light(s, sc->ids[j], sf, b, wo, smp, rays));
+                }
                 L = cdl_add(L, cdl_scale(Lj, 1.0f / (float)nj));
             }
         } else {
             /* fewer rays than lights: S lights drawn in proportion to power */
             for (uint32_t r = 0; r < S; r++) {
+                smp->dim = base + 2 + 2 * r;
                 float u = cdl_sampler_1d(smp) * W, acc = 0.0f;
                 uint32_t j = 0;
                 for (; j + 1 < n; j++) {
@@ -141,11 +148,14 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
     uint32_t rest = s->nlights - n;
     if (cfg->kind == CDL_DIRECT_LCON && rest) {
         /* one ray to a uniformly chosen light outside L_con, scaled by |rest| */
+        smp->dim = base;
         uint32_t r = (uint32_t)(cdl_sampler_1d(smp) * (float)rest);
         r = r < rest ? r : rest - 1;
         for (uint32_t j = 0; j < n && sc->ids[j] <= r; j++)
             r++; /* the r-th index not in the sorted L_con */
         L = cdl_add(L, cdl_scale(sample_light(s, r, sf, b, wo, smp, rays), (float)rest));
     }
+    uint32_t used = 2 + s->nlights * stride, drawn = 2 + 2 * S;
+    smp->dim = base + (used > drawn ? used : drawn);
     return L;
 }
