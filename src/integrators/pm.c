@@ -276,7 +276,9 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
 static int pm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     pm_state *st = self;
-    if (st->traced_pass != pass) {
+    /* direct light only (--maxdepth 1) reads no photon map but L_con's,
+     * which the first pass built: no photons to trace */
+    if (st->traced_pass != pass && st->opt.maxdepth > 1) {
         int rc = trace(st, pass, &film->rays, err);
         if (rc)
             return rc;
