@@ -11,30 +11,8 @@
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "test_util.h" /* CHECK, die_on */
 
-
-/* As test_util.h (not included: nothing here renders through an integrator) */
-static int test_failures = 0;
-
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        int ok_ = (cond);                                                                          \
-        printf("%s: ", ok_ ? "ok  " : "FAIL");                                                     \
-        printf(__VA_ARGS__);                                                                       \
-        printf("\n");                                                                              \
-        if (!ok_)                                                                                  \
-            test_failures++;                                                                       \
-    } while (0)
-
-static inline void die_on(int rc, const cdl_error *err)
-{
-    if (rc) {
-        char buf[2048];
-        cdl_error_format(err, buf, sizeof buf);
-        fprintf(stderr, "setup failed: %s\n", buf);
-        exit(2);
-    }
-}
 
 #define PI_D 3.14159265358979323846
 

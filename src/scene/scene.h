@@ -221,4 +221,14 @@ static inline float cdl_shadow_tmax(const cdl_scene *s, cdl_vec3 p, float dist)
     return t > 0.0f ? t : 0.0f;
 }
 
+/* 1 if nothing blocks the segment from surface point p (geometric normal
+ * ng) to the point of light sample ls on light l. */
+static inline int cdl_light_sample_visible(const cdl_scene *s, const cdl_light *l, cdl_vec3 p, cdl_vec3 ng,
+                                           const cdl_light_sample *ls)
+{
+    cdl_vec3 o = cdl_offset(s, p, ng, ls->wi);
+    uint32_t skip = l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
+    return !cdl_occluded_skip(s, o, ls->wi, cdl_shadow_tmax(s, p, ls->dist), skip);
+}
+
 #endif

@@ -76,10 +76,8 @@ static cdl_vec3 sample_light(const cdl_scene *s, uint32_t li, const cdl_surface 
     cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
     if (cdl_is_black(f))
         return f;
-    cdl_vec3 o = cdl_offset(s, sf->p, sf->ng, ls.wi);
     (*rays)++;
-    uint32_t skip = l->type == CDL_LIGHT_SPHERE ? l->prim : UINT32_MAX;
-    if (cdl_occluded_skip(s, o, ls.wi, cdl_shadow_tmax(s, sf->p, ls.dist), skip))
+    if (!cdl_light_sample_visible(s, l, sf->p, sf->ng, &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
     return cdl_scale(cdl_mul(f, ls.Li), cos / ls.pdf);
