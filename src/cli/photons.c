@@ -11,7 +11,7 @@
 #include "cli/render_args.h"
 #include "core/log.h"
 #include "film/image.h"
-#include "transport/photons.h"
+#include "integrators/pm.h"
 
 typedef struct view {
     int up, u, v; /* axes */
@@ -106,16 +106,13 @@ int cdl_cmd_photons(int argc, char **argv)
         snprintf(dot ? dot : defout + strlen(defout), 32, ".photons.png");
     }
     cdl_walk walk = {opt.maxdepth, opt.rr_depth};
-    float diag = cdl_length(cdl_sub(scene.bmax, scene.bmin));
-    float r = opt.pm.max_radius > 0.0f ? opt.pm.max_radius : 0.05f * diag;
-    if (!rc && opt.pm.importance) {
-        rc = cdl_importance_build(&imp, &scene, &opt.camera, &walk, opt.pm.importons, 1024, r, opt.sampler,
-                                  opt.seed, &err);
-        has_imp = rc == 0;
-    }
-    cdl_photon_params pp = {opt.pm.photons, opt.pm.caustic_ratio, opt.pm.caustic_random,
-                            has_imp ? &imp : NULL, opt.pm.eps, opt.pm.discard,
-                            opt.pm.max_paths ? opt.pm.max_paths : cdl_photons_default_max_paths(opt.pm.photons)};
+    float r = 0.0f;
+    cdl_photon_params pp = {0};
+    if (!rc)
+        rc = cdl_pm_max_radius(&scene, &opt.pm, &r, &err);
+    if (!rc)
+        rc = cdl_pm_photon_setup(&scene, &opt, &walk, r, &pp, &imp, &err);
+    has_imp = pp.imp != NULL;
     cdl_photon_stats ps;
     if (!rc)
         rc = cdl_photons_trace(&scene, &walk, &pp, opt.sampler, opt.seed, 0, &g, &c, &ps, &err);

@@ -343,8 +343,9 @@ static void default_output(const char *scene, const cdl_scene_settings *set, cha
 int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, cdl_options *opt,
                      char *defout, size_t ndefout, cdl_error *err)
 {
-    int rc;
-    rc = cdl_scene_init(scene, a->scene, err);
+    if (a->threads > 0)
+        omp_set_num_threads((int)a->threads);
+    int rc = cdl_scene_init(scene, a->scene, err);
     if (!rc)
         rc = cdl_scene_load(scene, a->scene, set, err);
     for (int i = 0; !rc && i < a->nlights; i++)
@@ -393,8 +394,6 @@ int cdl_cmd_render(int argc, char **argv)
         return 0;
     if (rc)
         return cdl_report(&err);
-    if (a.threads > 0)
-        omp_set_num_threads((int)a.threads);
 
     double t_load = cdl_time_now();
     cdl_scene scene;

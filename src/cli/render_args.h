@@ -37,7 +37,7 @@ typedef struct render_args {
 
 /* Parses argv; -1 after --help (help printed), else 0 or an error. */
 int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err);
-/* Loads a->scene (with --point-light additions), applies the file's
+/* Sets --threads, loads a->scene (with --point-light additions), applies the file's
  * settings, fills opt (camera included). defout receives the default
  * output name when no -o was given. */
 int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, cdl_options *opt,

@@ -20,7 +20,7 @@
 #include <string.h>
 
 #include "core/log.h"
-#include "integrators/integrator.h"
+#include "integrators/pm.h"
 #include "transport/light_select.h"
 #include "transport/photons.h"
 
@@ -93,10 +93,9 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     cdl_pmap_init(&st->global);
     cdl_pmap_init(&st->caustic);
     cdl_pmap_init(&st->direct);
-    float diag = cdl_length(cdl_sub(scene->bmax, scene->bmin));
-    float r = opt->pm.max_radius > 0.0f ? opt->pm.max_radius : 0.05f * diag;
-    if (!(r > 0.0f))
-        return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "the scene has no extent to size photon queries by");
+    float r;
+    if (cdl_pm_max_radius(scene, &opt->pm, &r, err))
+        return err->code;
     st->max_r2 = r * r;
     float rl = opt->pm.lcon_radius > 0.0f ? opt->pm.lcon_radius : r;
     st->lcon_r2 = rl * rl;
@@ -110,22 +109,11 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     st->dcfg.shadow_rays = opt->pm.shadow_rays ? opt->pm.shadow_rays : 1;
     st->dcfg.r2 = st->lcon_r2;
     st->dcfg.direct = &st->direct;
-    st->pp.target = opt->pm.photons;
-    st->pp.q = opt->pm.caustic_ratio;
-    st->pp.caustic_random = opt->pm.caustic_random;
-    st->pp.eps = opt->pm.eps;
-    st->pp.discard = opt->pm.discard;
-    st->pp.max_paths = opt->pm.max_paths ? opt->pm.max_paths : cdl_photons_default_max_paths(opt->pm.photons);
-    if (opt->pm.importance) {
-        double t0 = cdl_time_now();
-        int rc = cdl_importance_build(&st->imp, scene, &opt->camera, &st->walk, opt->pm.importons, 1024, r,
-                                      opt->sampler, opt->seed, err);
-        if (rc)
-            return rc;
-        st->has_imp = 1;
-        st->pp.imp = &st->imp;
-        st->t_importons = cdl_time_now() - t0;
-    }
+    double t0 = cdl_time_now();
+    if (cdl_pm_photon_setup(scene, opt, &st->walk, r, &st->pp, &st->imp, err))
+        return err->code;
+    st->has_imp = st->pp.imp != NULL;
+    st->t_importons = cdl_time_now() - t0;
     /* pass 0's photons now, so that a budget that cannot be met is an error before rendering */
     uint64_t rays = 0;
     int rc = trace(st, 0, &rays, err);
@@ -135,6 +123,29 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
                                      "light is sampled, their indirect light is missing");
             break;
         }
+    return rc;
+}
+
+int cdl_pm_max_radius(const cdl_scene *s, const cdl_pm_options *o, float *r, cdl_error *err)
+{
+    *r = o->max_radius > 0.0f ? o->max_radius : 0.05f * cdl_length(cdl_sub(s->bmax, s->bmin));
+    if (!(*r > 0.0f))
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "the scene has no extent to size photon queries by");
+    return 0;
+}
+
+int cdl_pm_photon_setup(const cdl_scene *s, const cdl_options *opt, const cdl_walk *walk, float max_radius,
+                        cdl_photon_params *pp, cdl_importance *imp, cdl_error *err)
+{
+    const cdl_pm_options *o = &opt->pm;
+    *pp = (cdl_photon_params){o->photons, o->caustic_ratio, o->caustic_random, NULL, o->eps, o->discard,
+                              o->max_paths ? o->max_paths : cdl_photons_default_max_paths(o->photons)};
+    if (!o->importance)
+        return 0;
+    int rc = cdl_importance_build(imp, s, &opt->camera, walk, o->importons, 1024, max_radius, opt->sampler,
+                                  opt->seed, err);
+    if (!rc)
+        pp->imp = imp;
     return rc;
 }
 

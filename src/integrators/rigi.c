@@ -48,7 +48,7 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
      * stop short of a distant mirror, so scenes with one trace full rays. */
     st->clip = 1;
     for (uint32_t i = 0; i < scene->nmats; i++)
-        if (scene->mats[i].type == CDL_MAT_MIRROR || scene->mats[i].type == CDL_MAT_DIELECTRIC)
+        if (cdl_mat_is_delta(scene->mats[i].type))
             st->clip = 0;
     if (clamped)
         st->t = opt->clamp > 0.0f ? opt->clamp : cdl_default_threshold(scene, opt);

@@ -32,7 +32,7 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
 
 static inline int cdl_bsdf_is_delta(const cdl_bsdf *b)
 {
-    return b->type == CDL_MAT_MIRROR || b->type == CDL_MAT_DIELECTRIC;
+    return cdl_mat_is_delta(b->type);
 }
 
 cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint);

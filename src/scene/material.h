@@ -16,6 +16,10 @@ typedef enum cdl_mat_type {
     CDL_MAT_ROUGH_DIELECTRIC /* GGX microfacet glass of index eta; ks, kt */
 } cdl_mat_type;
 
+/* Scatters only in Dirac directions (mirror, smooth glass): never connected
+ * to, never stores photons. */
+static inline int cdl_mat_is_delta(cdl_mat_type t) { return t == CDL_MAT_MIRROR || t == CDL_MAT_DIELECTRIC; }
+
 typedef struct cdl_material {
     cdl_mat_type type;
     cdl_vec3 kd;      /* diffuse reflectance, multiplied by the texture */

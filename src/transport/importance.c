@@ -13,12 +13,6 @@ typedef struct chunk_out {
     uint32_t n, cap;
 } chunk_out;
 
-static int is_delta(const cdl_scene *s, const cdl_vertex_store *vs, uint32_t i)
-{
-    cdl_mat_type t = s->mats[vs->mat[i]].type;
-    return t == CDL_MAT_MIRROR || t == CDL_MAT_DIELECTRIC;
-}
-
 /* Raster point of importon path i: stratified over the image, one
  * jittered sample per cell of a grid of about `paths` cells. */
 static void raster_point(const cdl_camera *cam, uint64_t i, uint64_t paths, cdl_sampler *smp, float *x,
@@ -70,7 +64,7 @@ int cdl_importance_build(cdl_importance *imp, const cdl_scene *s, const cdl_came
                 cdl_vs_clear(&vs);
                 uint32_t nv = cdl_trace_eye_subpath(s, cam, x, y, walk, &smp, &vs, &rays);
                 for (uint32_t v = 1; v < nv; v++) {
-                    if (is_delta(s, &vs, v))
+                    if (cdl_mat_is_delta(s->mats[vs.mat[v]].type))
                         continue;
                     float w = cdl_luminance(vs.beta[v]) * inv_paths;
                     if (!(w > 0.0f) || !isfinite(w))
@@ -141,7 +135,7 @@ int cdl_importance_build(cdl_importance *imp, const cdl_scene *s, const cdl_came
         uint64_t rays = 0;
         uint32_t nv = cdl_trace_eye_subpath(s, cam, x, y, walk, &smp, &vs, &rays);
         for (uint32_t v = 1; v < nv; v++)
-            if (!is_delta(s, &vs, v)) {
+            if (!cdl_mat_is_delta(s->mats[vs.mat[v]].type)) {
                 float I = cdl_importance_at(imp, vs.p[v]);
                 if (I > 0.0f) {
                     mn = I < mn ? I : mn;

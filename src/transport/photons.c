@@ -24,12 +24,6 @@ typedef struct trace_ctx {
     uint32_t pass;
 } trace_ctx;
 
-int cdl_photons_specular(const cdl_scene *s, uint32_t mat)
-{
-    cdl_mat_type t = s->mats[mat].type;
-    return t == CDL_MAT_MIRROR || t == CDL_MAT_DIELECTRIC;
-}
-
 static int push(cdl_photon **a, uint32_t *n, uint32_t *cap, const cdl_photon *ph)
 {
     if (*n == *cap) {
@@ -56,7 +50,7 @@ static void trace_path(const trace_ctx *cx, uint64_t i, int caustic_only, cdl_ve
         return;
     uint32_t light = (uint32_t)vs->light[0];
     for (uint32_t v = 1; v < nv; v++) {
-        if (cdl_photons_specular(cx->s, vs->mat[v]))
+        if (cdl_mat_is_delta(cx->s->mats[vs->mat[v]].type))
             continue;
         cdl_vec3 beta = vs->beta[v];
         if (cdl_is_black(beta) || !cdl_is_finite3(beta))
@@ -156,7 +150,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         return cdl_error_set(err, CDL_ERR_USAGE, "--photons", 0, "must be at least 1");
     int specular = 0;
     for (uint32_t m = 0; m < s->nmats; m++)
-        specular |= cdl_photons_specular(s, m);
+        specular |= cdl_mat_is_delta(s->mats[m].type);
     trace_ctx cx = {s, walk, pp, specular ? pp->q : 1.0f, kind, seed, pass};
 
     uint32_t maxchunks = MAX_BATCH / CHUNK;

@@ -49,7 +49,4 @@ static inline uint64_t cdl_photons_default_max_paths(uint32_t photons)
     return m > (1u << 20) ? m : (1u << 20);
 }
 
-/* Whether material m scatters specularly (its photons are caustic photons). */
-int cdl_photons_specular(const cdl_scene *s, uint32_t mat);
-
 #endif
