@@ -501,6 +501,36 @@ static void test_reference(const char *refdir)
     cdl_image_free(&ref);
 }
 
+/* Eight rows of a real render whose ZIP chunk compresses to exactly its
+ * packed size: OpenEXR <= 3.4.7 wrote zlib bytes that read back as raw
+ * pixels (NaN at one pixel). Must round-trip bit for bit. */
+static void test_exr_zip_stored(const char *data)
+{
+    char in[1024];
+    snprintf(in, sizeof in, "%s/exr_zip_stored.pfm", data);
+    cdl_image img, back;
+    cdl_error err = {0};
+    if (cdl_image_read(in, &img, &err)) {
+        CHECK(0, "read %s: %s", in, err.msg);
+        return;
+    }
+    CHECK(cdl_image_write(tmp_path("stored.exr"), &img, NULL, 0, 0.0f, &err) == 0, "%s", err.msg);
+    if (cdl_image_read(tmp_path("stored.exr"), &back, &err) == 0) {
+        size_t n = 3 * (size_t)img.width * (size_t)img.height, bad = 0, first = n;
+        for (size_t i = 0; i < n; i++)
+            if (memcmp(&img.rgb[i], &back.rgb[i], sizeof(float))) {
+                bad++;
+                first = first < i ? first : i;
+            }
+        CHECK(bad == 0, "ZIP chunk of incompressible size: %zu of %zu values differ (first at pixel %zu: %g)",
+              bad, n, first / 3, bad ? back.rgb[first] : 0.0);
+        printf("  ZIP chunk of incompressible size: %zu values, %zu differ\n", n, bad);
+        cdl_image_free(&back);
+    } else
+        CHECK(0, "read stored.exr: %s", err.msg);
+    cdl_image_free(&img);
+}
+
 /* The temp dir must hold no PATH.tmp-<pid> leftovers; then remove it. */
 static void clean_dir(void)
 {
@@ -527,6 +557,7 @@ int main(int argc, char **argv)
     test_roundtrip();
     printf("EXR layouts\n");
     test_exr_layouts();
+    test_exr_zip_stored(CDL_TEST_DATA);
     test_pfm_variants();
     printf("bad files\n");
     test_bad_files();

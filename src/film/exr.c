@@ -83,6 +83,25 @@ static const float *channel_source(const char *ch, const cdl_image *img, const c
     return src->rgb + off;
 }
 
+/* OpenEXR up to 3.4.7 stores a chunk whose zlib output is exactly as long as
+ * its packed pixels as if it were uncompressed, and readers then take the
+ * zlib bytes for pixels (openexr issue 2306; hit by real renders here). The
+ * default routine runs, and a chunk of that size is stored raw, as the
+ * format says a chunk that does not shrink is. */
+typedef exr_result_t (*compress_fn)(exr_encode_pipeline_t *);
+_Static_assert(sizeof(compress_fn) == sizeof(void *), "the default routine travels in encoding_user_data");
+
+static exr_result_t compress_guarded(exr_encode_pipeline_t *enc)
+{
+    compress_fn fn;
+    memcpy(&fn, &enc->encoding_user_data, sizeof fn);
+    exr_result_t rv = fn(enc);
+    if (rv == EXR_ERR_SUCCESS && enc->compressed_bytes == enc->packed_bytes &&
+        enc->compressed_buffer != enc->packed_buffer)
+        memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+    return rv;
+}
+
 int cdl_exr_write(const char *file, const char *name, const cdl_image *img,
                   const cdl_layer *layers, int nlayers, const cdl_kv *meta, int nmeta,
                   cdl_error *err)
@@ -153,6 +172,10 @@ int cdl_exr_write(const char *file, const char *name, const cdl_image *img,
             ch->user_bytes_per_element = sizeof(float);
         }
         rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+        if (rv == EXR_ERR_SUCCESS && enc.compress_fn && enc.compress_fn != compress_guarded) {
+            memcpy(&enc.encoding_user_data, &enc.compress_fn, sizeof(void *));
+            enc.compress_fn = compress_guarded;
+        }
         if (rv == EXR_ERR_SUCCESS)
             rv = exr_encoding_run(ctx, part, &enc);
     }
