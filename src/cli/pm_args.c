@@ -10,7 +10,7 @@
 static const char *valued[] = {"--photons",        "--knn",           "--max-radius", "--kernel",
                                "--gather",         "--importons",     "--importance-eps",
                                "--caustic-ratio",  "--caustic-select", "--direct",    "--lcon-radius",
-                               "--photon-paths-max", "--precompute"};
+                               "--photon-paths-max", "--precompute", "--visibility"};
 static const char *flags[] = {"--importance", "--importance-discard"};
 
 int cdl_pm_arg_kind(const char *o)
@@ -81,6 +81,15 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
             pm->caustic_random = 1;
         else
             return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected prefix or random, got '%s'", v);
+    } else if (!strcmp(o, "--visibility")) {
+        if (!strcmp(v, "gather"))
+            pm->visibility = CDL_PM_VIS_GATHER;
+        else if (!strcmp(v, "all"))
+            pm->visibility = CDL_PM_VIS_ALL;
+        else if (!strcmp(v, "off"))
+            pm->visibility = CDL_PM_VIS_OFF;
+        else
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected gather, all or off, got '%s'", v);
     } else if (!strcmp(o, "--direct")) {
         if (!strcmp(v, "power"))
             pm->direct = CDL_DIRECT_POWER;
@@ -115,8 +124,14 @@ void cdl_pm_args_help(void)
            "      --gather N          final gathering rays per pixel sample (default 8);\n"
            "                          0 shows the global map directly\n"
            "      --precompute M      gather rays landing on Lambertian surfaces read the\n"
-           "                          irradiance precomputed at every M-th photon\n"
-           "                          (Christensen 1999; default 4, 0 = a full estimate)\n"
+           "                          irradiance precomputed at 1 in M photons from the\n"
+           "                          others (Christensen 1999; default 4, 0 = a full\n"
+           "                          estimate; M >= 2)\n"
+           "      --visibility V      which estimates leave out photons hidden from the query\n"
+           "                          point (a shadow ray each): gather (default: those at\n"
+           "                          final-gather hits, incl. the precomputed irradiance),\n"
+           "                          all (also --gather 0 and caustics at the camera's\n"
+           "                          point) or off (Jensen's: leaks through thin walls)\n"
            "      --caustic-ratio q   only a fraction q of the paths fills the global map,\n"
            "                          all fill the caustic map (default 1)\n"
            "      --caustic-select S  prefix (the first q N paths, default) or random (a\n"

@@ -34,7 +34,14 @@ typedef struct cdl_pm_options {
     uint32_t shadow_rays;   /* S */
     float lcon_radius;      /* L_con query radius; <= 0: the maximum radius */
     uint64_t max_paths;     /* photon paths per pass before giving up; 0: 1000 per photon */
+    int visibility;         /* cdl_pm_visibility: which estimates test photon visibility */
 } cdl_pm_options;
+
+typedef enum {
+    CDL_PM_VIS_GATHER, /* estimates at final-gather hits and the precomputed irradiance */
+    CDL_PM_VIS_ALL,    /* also at the camera's point (--gather 0, caustics) */
+    CDL_PM_VIS_OFF     /* none: Jensen's estimate, which leaks through thin walls */
+} cdl_pm_visibility;
 
 typedef struct cdl_options {
     cdl_camera camera;

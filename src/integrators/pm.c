@@ -34,6 +34,7 @@ typedef struct pm_state {
     cdl_importance imp;
     int has_imp;
     float max_r2, lcon_r2;
+    cdl_vis vis_gather, vis_camera; /* photon visibility tests, or none */
     cdl_direct_cfg dcfg;
     uint32_t traced_pass; /* pass whose photons the maps hold, or UINT32_MAX */
     /* statistics */
@@ -65,7 +66,7 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
     }
     if (st->opt.pm.gather && st->opt.pm.precompute) {
         rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, st->opt.pm.k,
-                           st->max_r2, (cdl_kernel)st->opt.pm.kernel, err);
+                           st->max_r2, (cdl_kernel)st->opt.pm.kernel, st->vis_gather, err);
         if (rc)
             return rc;
     }
@@ -105,6 +106,15 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
         return cdl_error_set(err, CDL_ERR_USAGE, "--caustic-ratio", 0, "must be in (0, 1]");
     if (!(opt->pm.eps >= 0.0f && opt->pm.eps <= 1.0f))
         return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in [0, 1]");
+    if (opt->pm.precompute == 1)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
+                             "must be 0 (off) or at least 2: the photons that carry irradiance points "
+                             "cannot also estimate there");
+    if (opt->pm.visibility < CDL_PM_VIS_GATHER || opt->pm.visibility > CDL_PM_VIS_OFF)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--visibility", 0, "unknown kind %d", opt->pm.visibility);
+    cdl_vis vis = {cdl_photon_visible, scene}, none = {0};
+    st->vis_gather = opt->pm.visibility != CDL_PM_VIS_OFF ? vis : none;
+    st->vis_camera = opt->pm.visibility == CDL_PM_VIS_ALL ? vis : none;
     st->dcfg.kind = (cdl_direct_kind)opt->pm.direct;
     st->dcfg.shadow_rays = opt->pm.shadow_rays ? opt->pm.shadow_rays : 1;
     st->dcfg.r2 = st->lcon_r2;
@@ -150,7 +160,8 @@ int cdl_pm_photon_setup(const cdl_scene *s, const cdl_options *opt, const cdl_wa
 }
 
 typedef struct scratch {
-    cdl_pm_query qg, qc;
+    cdl_pm_query qg, qc;  /* at gather hits */
+    cdl_pm_query qgx, qcx; /* at the camera's point */
     cdl_lcon_scratch lc;
 } scratch;
 
@@ -159,7 +170,10 @@ typedef struct scratch {
 static cdl_vec3 photon_radiance(const pm_state *st, scratch *w, const cdl_surface *sf, const cdl_bsdf *b,
                                 cdl_vec3 wo)
 {
-    cdl_vec3 L = cdl_pmap_radiance(&st->global, &w->qg, sf->p, wo, b);
+    /* with precomputed points, a gather ray that found none reads the photons
+     * that carry none (photon_map.h: cdl_irr_map.est) */
+    const cdl_photon_map *g = st->irr.n ? &st->irr.est : &st->global;
+    cdl_vec3 L = cdl_pmap_radiance(g, &w->qg, sf->p, wo, b);
     if (st->caustic.n)
         L = cdl_add(L, cdl_pmap_radiance(&st->caustic, &w->qc, sf->p, wo, b));
     return L;
@@ -205,10 +219,10 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
         cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
         if (depth + 1 < st->opt.maxdepth) {
             if (st->caustic.n)
-                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qc, sf.p, wo, &b));
+                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
             uint32_t ng = st->opt.pm.gather;
             if (!ng) {
-                cdl_pm_query q = w->qg;
+                cdl_pm_query q = w->qgx;
                 q.skip = CDL_PH_PRIMARY; /* light sampling has the direct part */
                 Lx = cdl_add(Lx, cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b));
             }
@@ -233,7 +247,7 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
                 int found = 0;
                 if (bg.type == CDL_MAT_DIFFUSE && st->irr.n) {
                     cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
-                    cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, &found);
+                    cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, st->vis_gather, &found);
                     if (found)
                         Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
                 }
@@ -255,8 +269,11 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
     scratch w;
     uint32_t k = st->opt.pm.k;
     w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * k),
-                          malloc(sizeof(float) * k)};
+                          malloc(sizeof(float) * k), st->vis_gather};
     w.qc = w.qg;
+    w.qgx = w.qg;
+    w.qgx.vis = st->vis_camera;
+    w.qcx = w.qgx;
     uint64_t bad = 0, lsum = 0, lpts = 0;
     if (w.qg.idx && w.qg.d2 && !cdl_lcon_scratch_init(&w.lc, st->scene->nlights)) {
         for (int y = y0; y < y1; y++)

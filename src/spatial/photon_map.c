@@ -1,5 +1,7 @@
 #include "spatial/photon_map.h"
 
+#include "core/rng.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -114,7 +116,10 @@ static float kernel_w(cdl_kernel k, float d2, float r2)
         return 1.0f - sqrtf(d2 / r2);
     if (k == CDL_KERNEL_EPANECHNIKOV)
         return 1.0f - d2 / r2;
-    return 1.0f;
+    /* the photon that sets the radius lies on the rim and is not counted:
+     * k - 1 photons over pi r_k^2 is unbiased on a uniform density, k over
+     * it reads k / (k - 1) too high */
+    return d2 < r2 ? 1.0f : 0.0f;
 }
 
 static float kernel_area(cdl_kernel k, float r2)
@@ -127,17 +132,23 @@ static float kernel_area(cdl_kernel k, float r2)
  * the estimate: the k-th distance, or the maximum with fewer than k. */
 static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, float *r2)
 {
-    if (!m->n || !m->built)
+    if (!m->n || !m->built || !q->k)
         return 0;
     uint32_t n = cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
     *r2 = n == q->k ? q->d2[0] : q->max_r2;
     return *r2 > 0.0f ? n : 0;
 }
 
+static int visible(const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nx, const cdl_photon *ph)
+{
+    return !q->vis.fn || q->vis.fn(q->vis.ctx, x, nx, cdl_v3(ph->p[0], ph->p[1], ph->p[2]), cdl_photon_n(ph));
+}
+
 cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 wo,
                            const cdl_bsdf *b)
 {
     cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_vec3 nx = cdl_dot(b->ng, wo) < 0.0f ? cdl_neg(b->ng) : b->ng;
     float r2;
     uint32_t n = gather(m, q, x, &r2);
     for (uint32_t i = 0; i < n; i++) {
@@ -145,9 +156,9 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
         if (cdl_photon_flags(ph) & q->skip)
             continue;
         cdl_vec3 f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
-        if (cdl_is_black(f))
-            continue;
         float w = kernel_w(q->kernel, q->d2[i], r2);
+        if (cdl_is_black(f) || !(w > 0.0f) || !visible(q, x, nx, ph))
+            continue;
         L = cdl_add(L, cdl_scale(cdl_mul(f, cdl_v3(ph->power[0], ph->power[1], ph->power[2])), w));
     }
     return n ? cdl_scale(L, 1.0f / kernel_area(q->kernel, r2)) : L;
@@ -160,30 +171,71 @@ cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl
     uint32_t n = gather(m, q, x, &r2);
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
-        if ((cdl_photon_flags(ph) & q->skip) || cdl_dot(cdl_photon_n(ph), nrm) < 0.5f ||
-            cdl_dot(cdl_photon_wi(ph), nrm) <= 0.0f)
-            continue;
         float w = kernel_w(q->kernel, q->d2[i], r2);
+        if (!(w > 0.0f) || (cdl_photon_flags(ph) & q->skip) ||
+            cdl_dot(cdl_photon_n(ph), nrm) < -0.5f || cdl_dot(cdl_photon_wi(ph), nrm) <= 0.0f ||
+            !visible(q, x, nrm, ph))
+            continue;
         E = cdl_add(E, cdl_scale(cdl_v3(ph->power[0], ph->power[1], ph->power[2]), w));
     }
     return n ? cdl_scale(E, 1.0f / kernel_area(q->kernel, r2)) : E;
 }
 
+/* 1 in `every` photons carries an irradiance point, picked by a hash of its
+ * position: a thinning that does not depend on where the other photons lie. */
+static int carries_point(const cdl_photon *ph, uint32_t every)
+{
+    uint32_t b[3];
+    memcpy(b, ph->p, sizeof b);
+    uint64_t h = cdl_mix64(((uint64_t)b[0] << 32 | b[1]) ^ cdl_mix64(b[2]));
+    return h % every == 0;
+}
+
 int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
-                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_error *err)
+                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_vis vis, cdl_error *err)
 {
     cdl_irr_free(im);
-    every = every ? every : 1;
-    uint32_t n = (global->n + every - 1) / every;
+    if (every < 2)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
+                             "must be 0 (off) or at least 2: the photons that carry points cannot also "
+                             "estimate there");
+    /* A lookup takes the point nearest to where a gather ray lands, so no
+     * other point lies nearer: estimated from the points' own photons, the
+     * value would miss those (low where photons are sparse; with the point's
+     * own photon at the kernel's peak, high). The points' photons and the
+     * estimating ones are therefore disjoint, the latter carrying
+     * every / (every - 1) times their flux. */
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < global->n; i++)
+        n += (uint32_t)carries_point(&global->ph[i], every);
+    cdl_photon_map *est = &im->est;
     im->pt = malloc(sizeof(cdl_irr_point) * (n ? n : 1));
-    if (!im->pt)
-        return cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory for %u irradiance points", n);
+    int rc = im->pt ? 0 : cdl_error_set(err, CDL_ERR_SYSTEM, "photon map", 0, "out of memory for %u points", n);
+    uint32_t np = 0;
+    for (uint32_t i = 0; !rc && i < global->n; i++) {
+        const cdl_photon *ph = &global->ph[i];
+        if (carries_point(ph, every)) {
+            cdl_irr_point *p = &im->pt[np++];
+            memcpy(p->p, ph->p, sizeof p->p);
+            p->n = cdl_oct_encode_bits(cdl_photon_n(ph), 16);
+        } else {
+            rc = cdl_pmap_append(est, ph, 1, err);
+        }
+    }
+    if (!rc) {
+        cdl_pmap_scale(est, (float)every / (float)(every - 1));
+        rc = cdl_pmap_build(est, err);
+    }
+    if (rc) {
+        cdl_irr_free(im);
+        return rc;
+    }
     int fail = 0;
 #pragma omp parallel
     {
         uint32_t *idx = malloc(sizeof(uint32_t) * k);
         float *d2 = malloc(sizeof(float) * k);
-        cdl_pm_query q = {k, max_r2, kernel, 0, idx, d2};
+        cdl_pm_query q = {k, max_r2, kernel, 0, idx, d2, vis};
         if (!idx || !d2) {
 #pragma omp atomic write
             fail = 1;
@@ -192,17 +244,14 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
         for (int64_t i = 0; i < (int64_t)n; i++) {
             if (!idx || !d2)
                 continue;
-            const cdl_photon *ph = &global->ph[(size_t)i * every];
-            cdl_vec3 x = cdl_v3(ph->p[0], ph->p[1], ph->p[2]), nrm = cdl_photon_n(ph);
-            cdl_vec3 E = cdl_pmap_irradiance(global, &q, x, nrm);
+            cdl_irr_point *p = &im->pt[i];
+            cdl_vec3 x = cdl_v3(p->p[0], p->p[1], p->p[2]), nrm = cdl_oct_decode_bits(p->n, 16);
+            cdl_vec3 E = cdl_pmap_irradiance(est, &q, x, nrm);
             if (caustic->n)
                 E = cdl_add(E, cdl_pmap_irradiance(caustic, &q, x, nrm));
-            cdl_irr_point *p = &im->pt[i];
-            memcpy(p->p, ph->p, sizeof p->p);
             p->E[0] = E.x;
             p->E[1] = E.y;
             p->E[2] = E.z;
-            p->n = cdl_oct_encode_bits(nrm, 16);
         }
         free(idx);
         free(d2);
@@ -234,26 +283,33 @@ void cdl_irr_free(cdl_irr_map *im)
 {
     cdl_kd_free(&im->kd);
     free(im->pt);
+    cdl_pmap_free(&im->est);
     memset(im, 0, sizeof *im);
 }
 
-cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, int *found)
+static int irr_usable(const cdl_irr_point *p, cdl_vec3 x, cdl_vec3 n, cdl_vis vis)
+{
+    cdl_vec3 pn = cdl_oct_decode_bits(p->n, 16);
+    return cdl_dot(pn, n) > 0.9f && (!vis.fn || vis.fn(vis.ctx, x, n, cdl_v3(p->p[0], p->p[1], p->p[2]), pn));
+}
+
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, cdl_vis vis, int *found)
 {
     uint32_t idx[8];
     float d2[8];
     *found = 0;
     if (!im->n)
         return cdl_v3(0.0f, 0.0f, 0.0f);
-    /* the nearest point almost always matches: one cheap 1-NN search first */
-    uint32_t m = cdl_kd_knn(&im->kd, x, 1, max_r2, idx, d2);
-    if (m && cdl_dot(cdl_oct_decode_bits(im->pt[idx[0]].n, 16), n) > 0.9f) {
+    /* the nearest point almost always serves: one cheap 1-NN search first */
+    uint32_t m = cdl_kd_knn(&im->kd, x, 1, max_r2, idx, d2), tried = m ? idx[0] : UINT32_MAX;
+    if (m && irr_usable(&im->pt[idx[0]], x, n, vis)) {
         *found = 1;
         return cdl_v3(im->pt[idx[0]].E[0], im->pt[idx[0]].E[1], im->pt[idx[0]].E[2]);
     }
     m = m ? cdl_kd_knn(&im->kd, x, 8, max_r2, idx, d2) : 0;
     for (uint32_t i = 0; i < m; i++) {
         const cdl_irr_point *p = &im->pt[idx[i]];
-        if (cdl_dot(cdl_oct_decode_bits(p->n, 16), n) > 0.9f) {
+        if (idx[i] != tried && irr_usable(p, x, n, vis)) {
             *found = 1;
             return cdl_v3(p->E[0], p->E[1], p->E[2]);
         }

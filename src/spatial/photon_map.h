@@ -57,9 +57,20 @@ void cdl_pmap_scale(cdl_photon_map *m, float s);
 int cdl_pmap_build(cdl_photon_map *m, cdl_error *err);
 size_t cdl_pmap_bytes(const cdl_photon_map *m);
 
+/* Optional visibility test between a query point x (normal nx, on the
+ * side being estimated) and a stored point p (normal np): 0 when a surface
+ * lies between them. Estimates leave such photons out, so that light does
+ * not leak through a wall standing on a floor that runs under it. The
+ * spatial layer knows no geometry; the caller supplies the test. */
+typedef struct cdl_vis {
+    int (*fn)(const void *ctx, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np);
+    const void *ctx;
+} cdl_vis;
+
 /* A radiance query: k nearest within max_r2; photons with any of the
- * skip flags are left out of the sum (but still fix the radius, so the
- * estimate is that of the remaining subset). scratch must hold k. */
+ * skip flags, or that vis (if set) finds hidden, are left out of the sum
+ * (but still fix the radius, so the estimate is that of the remaining
+ * subset). scratch must hold k. */
 typedef struct cdl_pm_query {
     uint32_t k;
     float max_r2;
@@ -67,6 +78,7 @@ typedef struct cdl_pm_query {
     uint32_t skip;
     uint32_t *idx;
     float *d2;
+    cdl_vis vis;
 } cdl_pm_query;
 
 /* Reflected radiance at x towards wo: sum of f(wo, wi_p) flux_p w(d_p)
@@ -76,7 +88,7 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
 
 
 /* Precomputed irradiance (Christensen 1999): the irradiance from both
- * maps at every m-th global photon, so that a final-gathering ray that
+ * maps at 1 in m global photons, so that a final-gathering ray that
  * lands on a Lambertian surface costs one small lookup instead of a
  * k-nearest density estimate. */
 typedef struct cdl_irr_point {
@@ -89,20 +101,28 @@ typedef struct cdl_irr_map {
     cdl_irr_point *pt;
     uint32_t n;
     cdl_kdtree kd;
+    /* the global photons that carry no point, scaled to the full flux: where
+     * a lookup finds no point, an estimate from all photons would be low (the
+     * miss says the point photons are absent there); from these it is not */
+    cdl_photon_map est;
 } cdl_irr_map;
 
 /* Irradiance at x on a surface with normal n from the photons of m
  * arriving from n's side (photons of surfaces facing elsewhere left out). */
 cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 n);
+/* Irradiance at 1 in `every` (>= 2) global photons, estimated from the
+ * other global photons (k nearest, kept in im->est) and the caustic map;
+ * vis as in queries. */
 int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
-                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_error *err);
+                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_vis vis, cdl_error *err);
 void cdl_irr_free(cdl_irr_map *im);
 /* Irradiance of the nearest point within sqrt(max_r2) whose normal is
- * within about 25 degrees of n; 0 if there is none (*found = 0). */
-cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, int *found);
+ * within about 25 degrees of n (and that vis, if set, finds visible from
+ * x); 0 if there is none among the 8 nearest (*found = 0). */
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, cdl_vis vis, int *found);
 static inline size_t cdl_irr_bytes(const cdl_irr_map *im)
 {
-    return (size_t)im->n * sizeof(cdl_irr_point) + cdl_kd_bytes(&im->kd);
+    return (size_t)im->n * sizeof(cdl_irr_point) + cdl_kd_bytes(&im->kd) + cdl_pmap_bytes(&im->est);
 }
 
 #endif

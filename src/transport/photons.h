@@ -42,6 +42,10 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
                       cdl_sampler_kind kind, uint64_t seed, uint32_t pass, cdl_photon_map *global,
                       cdl_photon_map *caustic, cdl_photon_stats *st, cdl_error *err);
 
+/* cdl_vis test for photon estimates: 0 if a surface blocks the segment
+ * between x and p, both lifted off their surfaces (ctx: the cdl_scene). */
+int cdl_photon_visible(const void *scene, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np);
+
 /* The path limit when none is given: 1000 per photon, at least 2^20. */
 static inline uint64_t cdl_photons_default_max_paths(uint32_t photons)
 {
