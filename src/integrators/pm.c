@@ -31,6 +31,7 @@ typedef struct pm_state {
     cdl_photon_params pp;
     cdl_photon_map global, caustic, direct;
     cdl_irr_map irr;   /* precomputed irradiance for gather rays */
+    uint32_t ph_depth; /* deepest photon of both maps */
     cdl_importance imp;
     int has_imp;
     float max_r2, lcon_r2;
@@ -64,9 +65,20 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
         if (rc)
             return rc;
     }
+    st->ph_depth = 0;
+    for (int c = 0; c < 2; c++) {
+        const cdl_photon_map *m = c ? &st->caustic : &st->global;
+        for (uint32_t i = 0; i < m->n; i++) {
+            uint32_t d = cdl_photon_depth(&m->ph[i]);
+            st->ph_depth = d > st->ph_depth ? d : st->ph_depth;
+        }
+    }
     if (st->opt.pm.gather && st->opt.pm.precompute) {
-        rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, st->opt.pm.k,
-                           st->max_r2, (cdl_kernel)st->opt.pm.kernel, st->vis_gather, err);
+        /* for gather rays from the first vertex: the camera ray and the
+         * gather ray leave maxdepth - 1 bounces to the photons */
+        cdl_pm_query q = {st->opt.pm.k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, NULL, NULL,
+                          st->vis_gather, (uint32_t)st->opt.maxdepth - 1};
+        rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, &q, err);
         if (rc)
             return rc;
     }
@@ -167,12 +179,16 @@ typedef struct scratch {
 
 /* Radiance leaving the non-specular surface point of sf towards wo, from
  * both maps (at the end of a gather ray). */
+/* Both maps' radiance where a gather ray landed, from photons of at most
+ * `left` bounces. */
 static cdl_vec3 photon_radiance(const pm_state *st, scratch *w, const cdl_surface *sf, const cdl_bsdf *b,
-                                cdl_vec3 wo)
+                                cdl_vec3 wo, uint32_t left)
 {
     /* with precomputed points, a gather ray that found none reads the photons
      * that carry none (photon_map.h: cdl_irr_map.est) */
     const cdl_photon_map *g = st->irr.n ? &st->irr.est : &st->global;
+    w->qg.max_depth = left;
+    w->qc.max_depth = left;
     cdl_vec3 L = cdl_pmap_radiance(g, &w->qg, sf->p, wo, b);
     if (st->caustic.n)
         L = cdl_add(L, cdl_pmap_radiance(&st->caustic, &w->qc, sf->p, wo, b));
@@ -218,12 +234,17 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
             return L;
         cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
         if (depth + 1 < st->opt.maxdepth) {
+            /* --maxdepth counts the whole path: the photons here may have met
+             * as many surfaces as the camera path has bounces left */
+            uint32_t left = (uint32_t)(st->opt.maxdepth - depth);
+            w->qcx.max_depth = left;
             if (st->caustic.n)
                 Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
             uint32_t ng = st->opt.pm.gather;
             if (!ng) {
                 cdl_pm_query q = w->qgx;
                 q.skip = CDL_PH_PRIMARY; /* light sampling has the direct part */
+                q.max_depth = left;
                 Lx = cdl_add(Lx, cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b));
             }
             cdl_vec3 Lg = cdl_v3(0.0f, 0.0f, 0.0f);
@@ -245,14 +266,17 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
                     continue; /* specular then x: the caustic map's paths */
                 cdl_vec3 wg = cdl_neg(sc.wi);
                 int found = 0;
-                if (bg.type == CDL_MAT_DIFFUSE && st->irr.n) {
+                /* the points hold photons of up to maxdepth - 1 bounces: all a
+                 * gather from the first vertex may use, more after a mirror
+                 * unless no photon went that deep */
+                if (bg.type == CDL_MAT_DIFFUSE && st->irr.n && (depth == 0 || st->ph_depth <= left - 1)) {
                     cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
                     cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, st->vis_gather, &found);
                     if (found)
                         Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
                 }
                 if (!found)
-                    Lg = cdl_add(Lg, cdl_mul(sc.weight, photon_radiance(st, w, &sg, &bg, wg)));
+                    Lg = cdl_add(Lg, cdl_mul(sc.weight, photon_radiance(st, w, &sg, &bg, wg, left - 1)));
             }
             if (ng)
                 Lx = cdl_add(Lx, cdl_scale(Lg, 1.0f / (float)ng));
@@ -269,7 +293,7 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
     scratch w;
     uint32_t k = st->opt.pm.k;
     w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * k),
-                          malloc(sizeof(float) * k), st->vis_gather};
+                          malloc(sizeof(float) * k), st->vis_gather, 0};
     w.qc = w.qg;
     w.qgx = w.qg;
     w.qgx.vis = st->vis_camera;

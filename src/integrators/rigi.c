@@ -167,7 +167,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
             w->eye.mat[i] = sf.mat;
             w->eye.light[i] = sf.light;
             w->eye.flags[i] = 0;
-            w->eye.depth[i] = (uint16_t)stratum;
+            w->eye.depth[i] = (uint16_t)depth; /* < maxdepth + 1 <= 1025 */
             w->eye_pixel = realloc(w->eye_pixel, sizeof(uint32_t) * w->eye.cap);
             if (!w->eye_pixel)
                 return L;
@@ -229,8 +229,12 @@ static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const 
             if (j == 0 && st->scene->lights[lv->light[y]].type == CDL_LIGHT_SPHERE)
                 skip = st->scene->lights[lv->light[y]].prim;
             w->ncand = 0;
+            /* --maxdepth counts the whole path: x_1 .. x_i then y_j .. y_1 */
+            int room = st->opt.maxdepth - (int)lv->depth[y] - 1;
             for (uint32_t a = 0; a < nverts; a++) {
                 uint32_t e = verts[a];
+                if ((int)w->eye.depth[e] > room)
+                    continue;
                 cdl_vec3 ep = w->eye.p[e];
                 float G = cdl_geometry(ep, w->eye.ng[e], yp, yn);
                 if (!st->clamped && !delta_pos && strata_g(st, ep, w->eye.ng[e], yp, yn) >= st->t)
@@ -255,7 +259,7 @@ static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const 
                     return;
                 candidate *cd = &w->cand[w->ncand++];
                 cd->pixel = (uint32_t)pix_of[e];
-                cd->depth = w->eye.depth[e];
+                cd->depth = w->eye.depth[e] < CDL_STRATA ? w->eye.depth[e] : CDL_STRATA - 1;
                 cd->c = c;
                 cdl_vec3 dd = cdl_sub(yp, ep);
                 cd->o = cdl_offset(st->scene, ep, w->eye.ng[e], dd);

@@ -139,6 +139,11 @@ static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 
     return *r2 > 0.0f ? n : 0;
 }
 
+static int left_out(const cdl_pm_query *q, const cdl_photon *ph)
+{
+    return (cdl_photon_flags(ph) & q->skip) || (q->max_depth && cdl_photon_depth(ph) > q->max_depth);
+}
+
 static int visible(const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nx, const cdl_photon *ph)
 {
     return !q->vis.fn || q->vis.fn(q->vis.ctx, x, nx, cdl_v3(ph->p[0], ph->p[1], ph->p[2]), cdl_photon_n(ph));
@@ -153,7 +158,7 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     uint32_t n = gather(m, q, x, &r2);
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
-        if (cdl_photon_flags(ph) & q->skip)
+        if (left_out(q, ph))
             continue;
         cdl_vec3 f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
         float w = kernel_w(q->kernel, q->d2[i], r2);
@@ -172,7 +177,7 @@ cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
         float w = kernel_w(q->kernel, q->d2[i], r2);
-        if (!(w > 0.0f) || (cdl_photon_flags(ph) & q->skip) ||
+        if (!(w > 0.0f) || left_out(q, ph) ||
             cdl_dot(cdl_photon_n(ph), nrm) < -0.5f || cdl_dot(cdl_photon_wi(ph), nrm) <= 0.0f ||
             !visible(q, x, nrm, ph))
             continue;
@@ -192,8 +197,9 @@ static int carries_point(const cdl_photon *ph, uint32_t every)
 }
 
 int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
-                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_vis vis, cdl_error *err)
+                  uint32_t every, const cdl_pm_query *qt, cdl_error *err)
 {
+    uint32_t k = qt->k;
     cdl_irr_free(im);
     if (every < 2)
         return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
@@ -235,7 +241,7 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
     {
         uint32_t *idx = malloc(sizeof(uint32_t) * k);
         float *d2 = malloc(sizeof(float) * k);
-        cdl_pm_query q = {k, max_r2, kernel, 0, idx, d2, vis};
+        cdl_pm_query q = {k, qt->max_r2, qt->kernel, 0, idx, d2, qt->vis, qt->max_depth};
         if (!idx || !d2) {
 #pragma omp atomic write
             fail = 1;

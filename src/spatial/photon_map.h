@@ -18,19 +18,28 @@ enum {
 };
 
 /* 32 bytes: position, flux, incoming direction (octahedral, 2 x 15 bits)
- * with two flag bits, surface normal (octahedral, 2 x 8 bits) and the
- * index of the photon's light (0xffff past 65534 lights). */
+ * with two flag bits, surface normal (octahedral, 2 x 8 bits) and a tag:
+ * a primary photon's light (0xffff past 65534 lights; only L_con asks),
+ * any other photon's bounce count (--maxdepth counts whole paths). */
 typedef struct cdl_photon {
     float p[3];
     float power[3];
     uint32_t wi;     /* towards where the photon came from | flags << 30 */
     uint16_t n;      /* geometric normal on the side the photon arrived from */
-    uint16_t light;
+    uint16_t tag;
 } cdl_photon;
 
 #define CDL_PH_NO_LIGHT 0xffffu
-static inline uint32_t cdl_photon_light(const cdl_photon *ph) { return ph->light; }
 static inline uint32_t cdl_photon_flags(const cdl_photon *ph) { return ph->wi >> 30; }
+static inline uint32_t cdl_photon_light(const cdl_photon *ph)
+{
+    return (cdl_photon_flags(ph) & CDL_PH_PRIMARY) ? ph->tag : CDL_PH_NO_LIGHT;
+}
+/* Surfaces the photon's path met, its own included (1 = primary). */
+static inline uint32_t cdl_photon_depth(const cdl_photon *ph)
+{
+    return (cdl_photon_flags(ph) & CDL_PH_PRIMARY) ? 1u : ph->tag;
+}
 
 /* Octahedral encoding (Meyer et al. 2010) with `bits` per coordinate. */
 uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits);
@@ -79,6 +88,7 @@ typedef struct cdl_pm_query {
     uint32_t *idx;
     float *d2;
     cdl_vis vis;
+    uint32_t max_depth; /* photons of deeper bounces left out as skipped ones; 0: none */
 } cdl_pm_query;
 
 /* Reflected radiance at x towards wo: sum of f(wo, wi_p) flux_p w(d_p)
@@ -111,10 +121,10 @@ typedef struct cdl_irr_map {
  * arriving from n's side (photons of surfaces facing elsewhere left out). */
 cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 n);
 /* Irradiance at 1 in `every` (>= 2) global photons, estimated from the
- * other global photons (k nearest, kept in im->est) and the caustic map;
- * vis as in queries. */
+ * other global photons (kept in im->est) and the caustic map with the
+ * query q describes (its idx, d2 and skip are not used). */
 int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photon_map *caustic,
-                  uint32_t every, uint32_t k, float max_r2, cdl_kernel kernel, cdl_vis vis, cdl_error *err);
+                  uint32_t every, const cdl_pm_query *q, cdl_error *err);
 void cdl_irr_free(cdl_irr_map *im);
 /* Irradiance of the nearest point within sqrt(max_r2) whose normal is
  * within about 25 degrees of n (and that vis, if set, finds visible from

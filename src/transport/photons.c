@@ -90,7 +90,10 @@ static void trace_path(const trace_ctx *cx, uint64_t i, int caustic_only, cdl_ve
         /* the normal of the side the photon arrived on */
         cdl_vec3 ng = cdl_dot(vs->ng[v], vs->wi[v]) < 0.0f ? cdl_neg(vs->ng[v]) : vs->ng[v];
         ph.n = (uint16_t)cdl_oct_encode_bits(ng, 8);
-        ph.light = (uint16_t)(light < CDL_PH_NO_LIGHT ? light : CDL_PH_NO_LIGHT);
+        if (flags & CDL_PH_PRIMARY)
+            ph.tag = (uint16_t)(light < CDL_PH_NO_LIGHT ? light : CDL_PH_NO_LIGHT);
+        else
+            ph.tag = (uint16_t)vs->depth[v]; /* <= maxdepth <= 1024 */
         if (caustic ? push(&b->c, &b->nc, &b->capc, &ph) : push(&b->g, &b->ng, &b->capg, &ph))
             b->fail = 1;
     }
