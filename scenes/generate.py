@@ -594,6 +594,35 @@ def doorslit():
     return s
 
 
+def tworoom():
+    """Two rooms sharing one thin (5 cm) wall with an open doorway, the light in
+    the left one; the camera stands in the right room, seeing the dark side of
+    the shared wall on the left of the image and the lit room through the
+    doorway on the right. Floor and ceiling slabs run on under and over the
+    wall: a density estimate that ignores it reads the lit room's photons on
+    the dark side of the wall's foot."""
+    s = Scene("tworoom")
+    W, D, H, T, TS = 3.5, 3.5, 2.5, 0.05, 0.2
+    white = s.material("wall_white", kd=(0.75, 0.74, 0.71))
+    floor = s.material("floor", kd=(0.50, 0.45, 0.38))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    green = s.material("wall_green", kd=(0.20, 0.45, 0.25))
+    wood = s.material("wood", kd=(0.60, 0.45, 0.30))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(40, 40, 40))
+    X1 = W + T
+    s.shell(0, X1 + W, 0, D, H, TS, white, floor, ceil, {"-x": green})
+    s.group("shared_wall")
+    s.wall("z", W + T / 2, -TS / 2, D + TS / 2, T, white, doors=[(2.3, 3.2)], y1=H + 0.1,
+           door_h=2.0)
+    s.group("light")
+    s.light(1.4, 1.2, 1.0, 1.0, H - 0.01, lamp)
+    s.group("furniture")
+    s.box((0.5, 0, 2.2), (1.3, 0.8, 3.0), wood)             # a crate in the lit room
+    s.box((X1 + 1.6, 0, 0.5), (X1 + 2.4, 0.45, 1.3), wood)  # a low table in the dark one
+    s.camera = ((X1 + W - 0.3, 1.4, 0.35), (W, 0.9, 2.3), 70)
+    return s
+
+
 def floor_many_lights():
     s = Scene("floor_many_lights")
     W, D, H, T = 40.0, 20.0, 3.0, 0.2
@@ -724,6 +753,7 @@ SCENES = {
     "conference": conference,
     "rooms10x10": rooms10x10,
     "doorslit": doorslit,
+    "tworoom": tworoom,
     "floor_many_lights": floor_many_lights,
     "caustic_ring": caustic_ring,
 }
