@@ -56,6 +56,11 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
         pm->importons = (uint64_t)l;
     } else if (!strcmp(o, "--importance-eps")) {
         rc = cdl_arg_float(o, v, 0.0, 1.0, &d, err);
+        /* p = 0 would drop photons where no importon landed: bias */
+        if (!rc && !(d > 0.0))
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                                 "must be in (0, 1]: a zero bound drops photons no importon saw (biased), got '%s'",
+                                 v);
         pm->eps = (float)d;
     } else if (!strcmp(o, "--caustic-ratio")) {
         rc = cdl_arg_float(o, v, 0.0, 1.0, &d, err);
@@ -107,9 +112,6 @@ int cdl_pm_args_check(const cdl_pm_options *pm, cdl_error *err)
 {
     if (pm->discard && !pm->importance)
         return cdl_error_set(err, CDL_ERR_USAGE, "--importance-discard", 0, "needs --importance");
-    if (pm->discard && !(pm->eps > 0.0f))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--importance-discard", 0,
-                             "needs --importance-eps above 0 (photons below it are dropped)");
     return 0;
 }
 
@@ -139,7 +141,7 @@ void cdl_pm_args_help(void)
            "      --importance        store photons with probability p = min(1, f I(x)) from\n"
            "                          importons traced from the camera (power L / p)\n"
            "      --importons N       importon paths (default 131072)\n"
-           "      --importance-eps e  lower bound of p (default 0.01; unbiased)\n"
+           "      --importance-eps e  lower bound of p, in (0, 1] (default 0.01; unbiased)\n"
            "      --importance-discard  drop photons with p < e instead (biased)\n"
            "      --direct KIND       power (default: lights in proportion to power), lcon\n"
            "                          (S rays to the lights of nearby primary photons, one to\n"

@@ -236,21 +236,19 @@ static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const 
                 if ((int)w->eye.depth[e] > room)
                     continue;
                 cdl_vec3 ep = w->eye.p[e];
-                float G = cdl_geometry(ep, w->eye.ng[e], yp, yn);
                 if (!st->clamped && !delta_pos && strata_g(st, ep, w->eye.ng[e], yp, yn) >= st->t)
                     continue; /* §2a: this stratum belongs to the continued eye path */
-                if (st->clamped && G > st->t)
-                    G = st->t;
                 cdl_vec3 fe = cdl_vertex_f(&cx, &w->eye, e, cdl_madd(ep, w->eye.wi[e], 1.0f), yp, 0);
                 if (cdl_is_black(fe))
                     continue;
                 cdl_vec3 fl = cdl_vertex_f(&cx, lv, y, yfrom, ep, 1);
                 if (cdl_is_black(fl))
                     continue;
-                /* G with shading cosines, as bdpt's connections */
+                /* G with shading cosines, as bdpt's connections; ir clamps
+                 * that term itself (Fig. 2a), so smooth shading adds no bias */
                 float Gs = cdl_geometry(ep, w->eye.ns[e], yp, delta_pos ? yn : lv->ns[y]);
-                if (st->clamped)
-                    Gs = G < Gs ? G : Gs;
+                if (st->clamped && Gs > st->t)
+                    Gs = st->t;
                 cdl_vec3 c = cdl_scale(cdl_mul(cdl_mul(w->eye.beta[e], fe), cdl_mul(lv->beta[y], fl)),
                                        Gs * inv_m);
                 if (cdl_is_black(c) || !cdl_is_finite3(c))
