@@ -116,8 +116,8 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
         return cdl_error_set(err, CDL_ERR_USAGE, "--knn", 0, "must be in [1, 4096]");
     if (!(opt->pm.caustic_ratio > 0.0f && opt->pm.caustic_ratio <= 1.0f))
         return cdl_error_set(err, CDL_ERR_USAGE, "--caustic-ratio", 0, "must be in (0, 1]");
-    if (!(opt->pm.eps >= 0.0f && opt->pm.eps <= 1.0f))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in [0, 1]");
+    if (!(opt->pm.eps > 0.0f && opt->pm.eps <= 1.0f))
+        return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in (0, 1]");
     if (opt->pm.precompute == 1)
         return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
                              "must be 0 (off) or at least 2: the photons that carry irradiance points "
