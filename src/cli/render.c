@@ -51,8 +51,9 @@ static void render_help(void)
            "                          light (light tracing alone: every path through t = 1)\n"
            "      --threshold t       stratification threshold on G (default: the scene's\n"
            "                          diagonal d gives t = 1 / (0.15 d)^2); printed when used\n"
-           "      --light-paths K     K light paths per pass shared by all pixels\n"
-           "                          (bdpt default: one per pixel sample; ir/rigi default 1024)\n"
+           "      --light-paths K     K light paths per pass shared by all pixels, or\n"
+           "                          'sample': an independent one per pixel sample\n"
+           "                          (bdpt default: sample; ir/rigi default 1024)\n"
            "      --interleave N      N x N interleaved sets of the K paths (default 1)\n"
            "      --clamp c           ir: clamp G at c (default: 1 / (0.05 d)^2)\n"
            "      --strata KIND       rigi: geometry (threshold G, default) or distance\n"
@@ -211,7 +212,11 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
                                      "expected balance, power, stratified or light, got '%s'", v);
         } else if (!strcmp(o, "--light-paths")) {
-            rc = cdl_arg_int(o, v, 1, 100000000L, &a->light_paths, err);
+            /* "sample": an independent light path per pixel sample (-1) */
+            if (!strcmp(v, "sample"))
+                a->light_paths = -1;
+            else
+                rc = cdl_arg_int(o, v, 1, 100000000L, &a->light_paths, err);
         } else if (!strcmp(o, "--interleave")) {
             rc = cdl_arg_int(o, v, 1, 64, &a->interleave, err);
         } else if (!strcmp(o, "--threshold")) {
@@ -251,9 +256,9 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
     }
     if (!a->scene)
         return cdl_error_set(err, CDL_ERR_USAGE, "render", 0, "no scene file given (see candela render --help)");
-    if (a->interleave > 1 && !a->light_paths)
+    if (a->interleave > 1 && a->light_paths <= 0)
         return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "needs --light-paths K (the paths to interleave)");
-    if (a->light_paths && a->light_paths < a->interleave * a->interleave)
+    if (a->light_paths > 0 && a->light_paths < a->interleave * a->interleave)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "%ld paths cannot fill %ld x %ld interleaved sets", a->light_paths,
                              a->interleave, a->interleave);
@@ -365,7 +370,7 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
     opt->seed = a->seed;
     opt->sampler = a->sampler;
     opt->mis = a->mis;
-    opt->light_paths = (uint32_t)a->light_paths;
+    opt->light_paths = a->light_paths < 0 ? CDL_LIGHT_PATHS_PER_SAMPLE : (uint32_t)a->light_paths;
     opt->interleave = (uint32_t)a->interleave;
     opt->threshold = (float)a->threshold;
     opt->clamp = (float)a->clamp;

@@ -44,8 +44,10 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
         if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
             return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
                                  "bdpt does not support distant or infinite lights yet");
-    if (opt->light_paths && cdl_light_pool_init(&st->pool, opt->light_paths, opt->interleave,
-                                                opt->maxdepth, err))
+    if (st->opt.light_paths == CDL_LIGHT_PATHS_PER_SAMPLE)
+        st->opt.light_paths = 0; /* bdpt's default */
+    if (st->opt.light_paths && cdl_light_pool_init(&st->pool, st->opt.light_paths, opt->interleave,
+                                                   opt->maxdepth, err))
         return err->code;
     int tx = (opt->camera.width + 15) / 16, ty = (opt->camera.height + 15) / 16;
     st->ntiles = tx * ty;

@@ -43,6 +43,8 @@ typedef enum {
     CDL_PM_VIS_OFF     /* none: Jensen's estimate, which leaks through thin walls */
 } cdl_pm_visibility;
 
+#define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
+
 typedef struct cdl_options {
     cdl_camera camera;
     int maxdepth;   /* bounces, as in pbrt: 1 = direct light only */
@@ -52,7 +54,9 @@ typedef struct cdl_options {
 
     /* bdpt, ir, rigi (Kollig & Keller 2004) */
     cdl_mis_kind mis;      /* bdpt weighting */
-    uint32_t light_paths;  /* K light paths per pass shared by all pixels; 0 = one per pixel sample */
+    uint32_t light_paths;  /* K light paths per pass shared by all pixels; 0 = the method's default
+                            * (bdpt: one per pixel sample; ir/rigi: 1024); CDL_LIGHT_PATHS_PER_SAMPLE:
+                            * an independent one per pixel sample in every method */
     uint32_t interleave;   /* N: N x N interleaved sets of the K paths (1 = one set) */
     float threshold;       /* stratification threshold t on G; <= 0: derived from the scene */
     float clamp;           /* ir: clamp G at this value; <= 0: derived from the scene */

@@ -3,7 +3,9 @@
  *
  * Point lights are the vertices of K light paths per pass (the shared
  * light pool; y_0 on the emitters included), split into N x N interleaved
- * sets (--light-paths K, default 1024; --interleave N, default 1).
+ * sets (--light-paths K, default 1024; --interleave N, default 1), or
+ * one independent light path per pixel sample (--light-paths sample: the
+ * "pure Monte Carlo" left column of the report's Figure 6).
  *
  * rigi: at each eye vertex x_i, a shadow ray goes only to point lights
  * y_j with G(x_i, y_j) < t (eq. 2-3); one BSDF-sampled ray is traced, clipped
@@ -32,6 +34,7 @@ typedef struct rigi_state {
     float t;      /* threshold (rigi) or clamp (ir) */
     int clamped;  /* ir */
     int clip;     /* §4.1 clipping is only safe without specular surfaces */
+    int per_sample; /* an independent light path per pixel sample, no pool */
     cdl_light_pool pool;
 } rigi_state;
 
@@ -59,6 +62,11 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
             return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
                                  "%s does not support distant or infinite lights yet",
                                  clamped ? "ir" : "rigi");
+    st->per_sample = opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE;
+    if (st->per_sample)
+        return opt->interleave > 1 ? cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0,
+                                                   "needs --light-paths K (the paths to interleave)")
+                                   : 0;
     uint32_t k = opt->light_paths ? opt->light_paths : 1024;
     if (cdl_light_pool_init(&st->pool, k, opt->interleave, opt->maxdepth, err))
         return err->code;
@@ -206,10 +214,10 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
 /* All point lights of one interleaved set against the tile's eye vertices
  * of that set: candidates with G < t (ir: every one, G clamped), then one
  * shadow-ray bundle per point light. */
-static void connect_set(const rigi_state *st, tile_work *w, uint32_t set, const uint32_t *verts,
-                        uint32_t nverts, const int *pix_of, cdl_vec3 *acc, uint64_t *rays)
+static void connect_set(const rigi_state *st, const cdl_light_pool *lp, tile_work *w, uint32_t set,
+                        const uint32_t *verts, uint32_t nverts, const int *pix_of, cdl_vec3 *acc,
+                        uint64_t *rays)
 {
-    const cdl_light_pool *lp = &st->pool;
     const cdl_vertex_store *lv = &lp->vs;
     uint32_t m = cdl_light_pool_set_size(lp, set);
     if (!m || !nverts)
@@ -312,6 +320,18 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     cdl_vs_init(&w->eye);
     cdl_vec3 acc[256];
     int pix_sets[256];
+    /* --light-paths sample: the tile's own pool, pixel p's path in set p */
+    cdl_light_pool local;
+    const cdl_light_pool *lp = &st->pool;
+    if (st->per_sample) {
+        if (cdl_light_pool_init(&local, (uint32_t)np, 1, st->opt.maxdepth, NULL)) {
+            cdl_light_pool_free(&local);
+            free(w);
+            return 0;
+        }
+        local.sets = (uint32_t)np;
+        lp = &local;
+    }
     /* eye paths of every pixel first, so that shadow rays can be bundled */
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
@@ -323,7 +343,19 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             cdl_sampler_2d(&smp, &jx, &jy);
             acc[p] = eye_path(st, &smp, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
                               (uint32_t)p, w, rays);
-            pix_sets[p] = (int)cdl_light_pool_set(&st->pool, x, y);
+            if (!st->per_sample) {
+                pix_sets[p] = (int)cdl_light_pool_set(&st->pool, x, y);
+            } else {
+                /* seeded as bdpt's independent light paths */
+                uint64_t pix = (uint64_t)y * (uint64_t)film->width + (uint64_t)x;
+                uint64_t npix = (uint64_t)film->width * (uint64_t)film->height;
+                cdl_sampler lsmp;
+                cdl_sampler_start(&lsmp, st->opt.sampler, st->opt.seed, pix + npix, pass);
+                cdl_vertex_store view = local.vs;
+                view.n = (uint32_t)p * local.stride;
+                local.len[p] = cdl_trace_light_subpath(st->scene, &st->walk, &lsmp, &view, rays);
+                pix_sets[p] = p;
+            }
         }
     /* group the eye vertices by interleaved set */
     uint32_t nv = w->eye.n;
@@ -332,12 +364,12 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     if (order && pix_of) {
         for (uint32_t e = 0; e < nv; e++)
             pix_of[e] = (int)w->eye_pixel[e];
-        for (uint32_t set = 0; set < st->pool.sets; set++) {
+        for (uint32_t set = 0; set < lp->sets; set++) {
             uint32_t n = 0;
             for (uint32_t e = 0; e < nv; e++)
                 if ((uint32_t)pix_sets[pix_of[e]] == set)
                     order[n++] = e;
-            connect_set(st, w, set, order, n, pix_of, acc, rays);
+            connect_set(st, lp, w, set, order, n, pix_of, acc, rays);
         }
     }
     uint64_t bad = 0;
@@ -357,6 +389,8 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     }
     free(order);
     free(pix_of);
+    if (st->per_sample)
+        cdl_light_pool_free(&local);
     cdl_vs_free(&w->eye);
     free(w->eye_pixel);
     free(w->cand);
@@ -372,7 +406,8 @@ static int rigi_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
 {
     (void)err;
     rigi_state *st = self;
-    cdl_light_pool_trace(&st->pool, st->scene, &st->walk, st->opt.sampler, st->opt.seed, pass, &film->rays);
+    if (!st->per_sample)
+        cdl_light_pool_trace(&st->pool, st->scene, &st->walk, st->opt.sampler, st->opt.seed, pass, &film->rays);
     cdl_render_tiles(self, film, pass, rigi_tile);
     return 0;
 }
