@@ -20,8 +20,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: candela render SCENE [options]    render a scene\n"
             "       candela photons SCENE [options]   the photon map (and importons) from above\n"
-            "       candela diff TEST REF [--heatmap OUT.png]\n"
-            "                                         compare two images\n"
+            "       candela diff TEST REF [--heatmap OUT.png] [--region X0,Y0,X1,Y1]\n"
+            "                                         compare two images (or one region)\n"
             "       candela --help | --version\n"
             "\n"
             "`candela render --help` lists the render options and integrators.\n");
