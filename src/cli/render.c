@@ -12,6 +12,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/gkde_args.h"
 #include "cli/pm_args.h"
 #include "cli/render_args.h"
 #include "core/log.h"
@@ -66,6 +67,7 @@ static void render_help(void)
            "  -q, --quiet             no warnings, no progress bar\n"
            "\n");
     cdl_pm_args_help();
+    cdl_gkde_args_help();
     printf("Integrators:\n");
     for (const cdl_integrator_vtbl *const *it = cdl_integrator_list(); *it; it++)
         printf("  %-8s %s\n", (*it)->name, (*it)->summary);
@@ -99,6 +101,7 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
     cdl_options defaults;
     cdl_options_default(&defaults);
     a->pm = defaults.pm;
+    a->gkde = defaults.gkde;
     a->integrator = "path";
     a->spp = 0;
     a->width = 512;
@@ -122,6 +125,14 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
             if (a->scene)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "only one scene file may be given");
             a->scene = o;
+            continue;
+        }
+        if (cdl_gkde_arg_kind(o)) {
+            if (i + 1 >= argc)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
+            int grc = cdl_gkde_arg(o, argv[++i], &a->gkde, err);
+            if (grc)
+                return grc;
             continue;
         }
         int pk = cdl_pm_arg_kind(o);
@@ -378,6 +389,7 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
     opt->strata_distance = a->strata_distance;
     opt->single_shadow_rays = a->single_shadow_rays;
     opt->pm = a->pm;
+    opt->gkde = a->gkde;
     if (!rc && a->has_lookat)
         rc = cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
                              cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),

@@ -31,6 +31,7 @@ typedef struct render_args {
     int strata_distance, single_shadow_rays;
     int aov_pathlength, aov_strata;
     cdl_pm_options pm;
+    cdl_gkde_options gkde;
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;

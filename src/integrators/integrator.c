@@ -10,10 +10,11 @@ extern const cdl_integrator_vtbl cdl_bdpt_integrator;
 extern const cdl_integrator_vtbl cdl_ir_integrator;
 extern const cdl_integrator_vtbl cdl_rigi_integrator;
 extern const cdl_integrator_vtbl cdl_pm_integrator;
+extern const cdl_integrator_vtbl cdl_gkde_integrator;
 
 static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
                                                  &cdl_ir_integrator, &cdl_rigi_integrator,
-                                                 &cdl_pm_integrator, NULL};
+                                                 &cdl_pm_integrator, &cdl_gkde_integrator, NULL};
 
 void cdl_options_default(cdl_options *o)
 {
@@ -32,6 +33,9 @@ void cdl_options_default(cdl_options *o)
     o->pm.eps = 0.01f;
     o->pm.caustic_ratio = 1.0f;
     o->pm.shadow_rays = 4;
+    o->gkde.eye_paths = 1;
+    o->gkde.links = 10;
+    o->gkde.max_mib = 4096;
 }
 
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)

@@ -43,6 +43,14 @@ typedef enum {
     CDL_PM_VIS_OFF     /* none: Jensen's estimate, which leaks through thin walls */
 } cdl_pm_visibility;
 
+/* gkde: generalized kernel density estimation (Bekaert et al. 2003) */
+typedef struct cdl_gkde_options {
+    uint32_t eye_paths;  /* eye paths per pixel and step */
+    uint32_t links;      /* M: unoccluded links wanted per eye vertex (§5) */
+    float bandwidth;     /* h of eq. 7; <= 0: calibrated in the first step */
+    uint32_t max_mib;    /* cap on the stored path vertices (MiB) */
+} cdl_gkde_options;
+
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 typedef struct cdl_options {
@@ -55,7 +63,8 @@ typedef struct cdl_options {
     /* bdpt, ir, rigi (Kollig & Keller 2004) */
     cdl_mis_kind mis;      /* bdpt weighting */
     uint32_t light_paths;  /* K light paths per pass shared by all pixels; 0 = the method's default
-                            * (bdpt: one per pixel sample; ir/rigi: 1024); CDL_LIGHT_PATHS_PER_SAMPLE:
+                            * (bdpt: one per pixel sample; ir/rigi: 256 in 4 x 4 sets; gkde: 100000
+                            * per step); CDL_LIGHT_PATHS_PER_SAMPLE:
                             * an independent one per pixel sample in every method */
     uint32_t interleave;   /* N: N x N interleaved sets of the K paths (1 = one set) */
     float threshold;       /* stratification threshold t on G; <= 0: derived from the scene */
@@ -64,6 +73,7 @@ typedef struct cdl_options {
     int single_shadow_rays; /* rigi/ir: trace shadow rays one by one instead of as bundles */
 
     cdl_pm_options pm;
+    cdl_gkde_options gkde;
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the

@@ -249,3 +249,9 @@ uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn,
 {
     return t->n ? ball_search(t, 0, t->n, q, r2, fn, ctx) : 0;
 }
+
+uint32_t cdl_kd_ball_range(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2,
+                           cdl_kd_visit fn, void *ctx)
+{
+    return lo < hi && hi <= t->n ? ball_search(t, lo, hi, q, r2, fn, ctx) : 0;
+}

@@ -64,17 +64,9 @@ static cdl_vec3 vshading(const cdl_vertex_store *vs, uint32_t i)
     return vs->ns[i];
 }
 
-/* Area density at `to` (normal nt) of sampling it from vertex i, which was
- * reached from position `from` (ignored for the camera and lights). */
-static float vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
-                        cdl_vec3 from, cdl_vec3 to, cdl_vec3 nt)
+float cdl_vertex_pdf_sa(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
+                        cdl_vec3 w)
 {
-    cdl_vec3 p = vs->p[i];
-    cdl_vec3 w = cdl_sub(to, p);
-    float len = cdl_length(w);
-    if (!(len > 0.0f))
-        return 0.0f;
-    w = cdl_scale(w, 1.0f / len);
     float pdf_sa;
     if (vs->flags[i] & CDL_V_CAMERA) {
         cdl_camera_We(cx->cam, w, &pdf_sa);
@@ -83,9 +75,20 @@ static float vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, u
     } else {
         cdl_bsdf b;
         cdl_vs_bsdf(cx->scene, vs, i, &b);
-        pdf_sa = cdl_bsdf_pdf(&b, cdl_normalize(cdl_sub(from, p)), w);
+        pdf_sa = cdl_bsdf_pdf(&b, cdl_normalize(cdl_sub(from, vs->p[i])), w);
     }
-    return cdl_pdf_to_area(pdf_sa, p, to, nt);
+    return pdf_sa;
+}
+
+float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
+                     cdl_vec3 to, cdl_vec3 nt)
+{
+    cdl_vec3 p = vs->p[i];
+    cdl_vec3 w = cdl_sub(to, p);
+    float len = cdl_length(w);
+    if (!(len > 0.0f))
+        return 0.0f;
+    return cdl_pdf_to_area(cdl_vertex_pdf_sa(cx, vs, i, from, cdl_scale(w, 1.0f / len)), p, to, nt);
 }
 
 /* f at vertex i for light arriving from `from` and leaving to `to` (eye
@@ -204,11 +207,11 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     cdl_vec3 np = cdl_vertex_normal(evs, pt), nq = cdl_vertex_normal(lvs, qs);
     v[pt].g_next = cdl_geometry(pp, np, qp, nq);
     /* densities through the new edge, both ways (pbrt-v3's MISWeight) */
-    v[pt].pdf_light = vertex_pdf(cx, lvs, qs, qm, pp, np);
-    v[pt - 1].pdf_light = vertex_pdf(cx, evs, pt, qp, pm, cdl_vertex_normal(evs, pt - 1));
-    v[t].pdf_eye = vertex_pdf(cx, evs, pt, pm, qp, nq);
+    v[pt].pdf_light = cdl_vertex_pdf(cx, lvs, qs, qm, pp, np);
+    v[pt - 1].pdf_light = cdl_vertex_pdf(cx, evs, pt, qp, pm, cdl_vertex_normal(evs, pt - 1));
+    v[t].pdf_eye = cdl_vertex_pdf(cx, evs, pt, pm, qp, nq);
     if (s >= 2)
-        v[t + 1].pdf_eye = vertex_pdf(cx, lvs, qs, pp, qm, cdl_vertex_normal(lvs, qs - 1));
+        v[t + 1].pdf_eye = cdl_vertex_pdf(cx, lvs, qs, pp, qm, cdl_vertex_normal(lvs, qs - 1));
     v[pt].delta = v[t].delta = 0;
     v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
                                        s >= 2 ? lvs->p[l0 + 1] : pp);
@@ -259,7 +262,7 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     v[s].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
     cdl_vec3 nq = cdl_vertex_normal(lvs, qs);
     v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
-    v[2].pdf_eye = vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
+    v[2].pdf_eye = cdl_vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
     v[1].delta = 0;
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
     float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, cx->counts, cx->threshold);

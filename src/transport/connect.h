@@ -34,6 +34,15 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
  * for point and spot lights. */
 cdl_vec3 cdl_vertex_normal(const cdl_vertex_store *vs, uint32_t i);
 
+/* Solid-angle density of vertex i (reached from position `from`; ignored
+ * for the camera and lights) sampling the unit direction w: the camera's,
+ * the light's emission or the BSDF's. */
+float cdl_vertex_pdf_sa(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
+                        cdl_vec3 w);
+/* The same as an area density at `to` (normal nt; zero: a point). */
+float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
+                     cdl_vec3 to, cdl_vec3 nt);
+
 /* f at vertex i for light arriving from position `from` and leaving to
  * `to`: eye vertices in radiance mode, light vertices (light_side) in
  * importance mode with Veach's shading-normal correction, y_0 the light's

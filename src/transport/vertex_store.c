@@ -44,6 +44,23 @@ int cdl_vs_reserve(cdl_vertex_store *vs, uint32_t n, cdl_error *err)
     return 0;
 }
 
+int cdl_vs_append(cdl_vertex_store *dst, const cdl_vertex_store *src, cdl_error *err)
+{
+    if ((uint64_t)dst->n + src->n > UINT32_MAX / 2)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "vertex store too large");
+    int rc = cdl_vs_reserve(dst, dst->n + src->n, err);
+    if (rc)
+        return rc;
+#define COPY(f) memcpy(dst->f + dst->n, src->f, (size_t)src->n * sizeof *src->f);
+    VS_FIELDS(COPY)
+#undef COPY
+    for (uint32_t i = 0; i < src->n; i++)
+        if (src->parent[i] >= 0)
+            dst->parent[dst->n + i] = src->parent[i] + (int32_t)dst->n;
+    dst->n += src->n;
+    return 0;
+}
+
 size_t cdl_vs_bytes(const cdl_vertex_store *vs)
 {
     size_t per = 0;

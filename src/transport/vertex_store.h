@@ -39,6 +39,8 @@ void cdl_vs_free(cdl_vertex_store *vs);
 /* Capacity for at least n vertices in total; keeps the contents. */
 int cdl_vs_reserve(cdl_vertex_store *vs, uint32_t n, cdl_error *err);
 static inline void cdl_vs_clear(cdl_vertex_store *vs) { vs->n = 0; }
+/* Appends src's vertices to dst, parent indices shifted to match. */
+int cdl_vs_append(cdl_vertex_store *dst, const cdl_vertex_store *src, cdl_error *err);
 /* Bytes held, for memory reports. */
 size_t cdl_vs_bytes(const cdl_vertex_store *vs);
 

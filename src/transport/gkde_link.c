@@ -1,0 +1,165 @@
+#include "transport/gkde_link.h"
+
+#include "transport/subpath.h"
+
+#define MAX_PATH 2100 /* two subpaths of at most maxdepth (1024) + 2 vertices */
+
+/* Per-vertex densities of a full path z_0 .. z_{n-1} (light to eye). */
+typedef struct path_pdfs {
+    float pl[MAX_PATH]; /* area density of z_i sampled from the light side (z_0: as a light-path start) */
+    float pe[MAX_PATH]; /* area density of z_i sampled from the eye side */
+    uint8_t delta[MAX_PATH];
+    int n;
+    int s0; /* the eye path alone can sample it (z_0 on an area light) */
+} path_pdfs;
+
+static cdl_vec3 point_normal(const cdl_vertex_store *vs, uint32_t i)
+{
+    return (vs->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT)) ? cdl_v3(0.0f, 0.0f, 0.0f) : vs->ng[i];
+}
+
+static float log1(float p) { return p > 0.0f ? logf(p) : 0.0f; } /* Dirac or unknown: cancels */
+
+/* Weight of strategy `cur` (merge at z_cur; 0: the eye path alone) among
+ * every strategy that can sample the path: the balance heuristic over
+ * d_j = prod_{i<=j} pl_i prod_{i>=j} pe_i N pi R_j^2 (merging at z_j: the
+ * light path to z_{j-1}, a light vertex in a footprint of radius R_j of
+ * eq. 7 around z_j, found by one of N light paths) and d_0 = prod pe_i. It
+ * is eq. 9 for two strategies; a partition of unity for any path, so the
+ * strategies' sum stays consistent. */
+static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
+{
+    int n = pp->n;
+    double lsum_pe[MAX_PATH + 1];
+    lsum_pe[n] = 0.0;
+    for (int i = n - 1; i >= 0; i--)
+        lsum_pe[i] = lsum_pe[i + 1] + log1(pp->pe[i]);
+    double ld[MAX_PATH];
+    uint8_t ok[MAX_PATH];
+    double lpl = log1(pp->pl[0]), best = -INFINITY;
+    double lnpi = log((double)g->n_light * CDL_PI);
+    float r = 0.0f;
+    ok[0] = (uint8_t)pp->s0;
+    ld[0] = lsum_pe[0];
+    if (ok[0])
+        best = ld[0];
+    for (int j = 1; j < n; j++) {
+        lpl += log1(pp->pl[j]);
+        r = cdl_footprint_radius(g->h, pp->pl[j], r);
+        ok[j] = !pp->delta[j] && !pp->delta[j - 1] && r > 0.0f;
+        ld[j] = lpl + lsum_pe[j] + lnpi + 2.0 * log((double)r);
+        if (ok[j] && ld[j] > best)
+            best = ld[j];
+    }
+    if (!ok[cur] || !isfinite(best))
+        return 0.0f;
+    double sum = 0.0;
+    for (int j = 0; j < n; j++)
+        if (ok[j])
+            sum += exp(ld[j] - best);
+    return (float)(exp(ld[cur] - best) / sum);
+}
+
+/* The eye vertices of y's path from y (depth l) down to y_1 fill z_k ..
+ * z_{k+l-1}; light-side densities from z_{k+2} on are the stored reverse
+ * ones (the caller sets z_k and z_{k+1}). Returns 0 if too long. */
+static int fill_eye(const cdl_vertex_store *evs, uint32_t y, int k, path_pdfs *pp)
+{
+    int l = evs->depth[y];
+    if (k + l > MAX_PATH)
+        return 0;
+    pp->n = k + l;
+    int32_t v = (int32_t)y;
+    for (int i = k; i < k + l; i++, v = evs->parent[v]) {
+        pp->pe[i] = evs->pdf_fwd[v];
+        pp->pl[i] = evs->pdf_rev[v];
+        pp->delta[i] = (evs->flags[v] & CDL_V_DELTA) != 0;
+    }
+    return 1;
+}
+
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y)
+{
+    const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    int32_t xp = lvs->parent[xk];
+    if (xp < 0 || (lvs->flags[xp] & CDL_V_DELTA) || (evs->flags[y] & (CDL_V_DELTA | CDL_V_CAMERA)))
+        return zero;
+    cdl_vec3 px = lvs->p[xp], py = evs->p[y], d = cdl_sub(py, px);
+    float r2 = cdl_dot(d, d);
+    if (!(r2 > 0.0f))
+        return zero;
+    cdl_vec3 w = cdl_scale(d, 1.0f / sqrtf(r2));
+    int32_t xpp = lvs->parent[xp], ye = evs->parent[y];
+    cdl_vec3 from_x = xpp >= 0 ? lvs->p[xpp] : px, to_y = evs->p[ye];
+    cdl_vec3 fl = cdl_vertex_f(&g->cx, lvs, (uint32_t)xp, from_x, py, 1);
+    if (cdl_is_black(fl))
+        return zero;
+    cdl_vec3 fe = cdl_vertex_f(&g->cx, evs, y, px, to_y, 0);
+    if (cdl_is_black(fe))
+        return zero;
+    float p_sa = cdl_vertex_pdf_sa(&g->cx, lvs, (uint32_t)xp, from_x, w);
+    if (!(p_sa > 0.0f))
+        return zero;
+    cdl_vec3 nx = (lvs->flags[xp] & CDL_V_DELTA_LIGHT) ? zero : lvs->ns[xp];
+    float cos_x = cdl_is_black(nx) ? 1.0f : fabsf(cdl_dot(nx, w));
+    float cos_y = fabsf(cdl_dot(evs->ns[y], w));
+    /* the footprint's disc seen from x_{k-1} (eq. 8b); a grazing x_k has
+     * a vanishing disc, kept finite */
+    float cos_k = cdl_maxf(fabsf(cdl_dot(lvs->ng[xk], lvs->wi[xk])), 1e-3f);
+    float R = g->radius[xk];
+    float kern = cos_x * cos_y / (CDL_PI * R * R * cos_k * p_sa);
+    cdl_vec3 c = cdl_mul(cdl_mul(lvs->beta[xp], fl), cdl_mul(fe, evs->beta[y]));
+    c = cdl_scale(c, kern / g->n_light);
+    if (cdl_is_black(c) || !cdl_is_finite3(c))
+        return zero;
+
+    /* the path: x_0 .. x_{k-1}, then y_l .. y_1 */
+    path_pdfs pp;
+    int k = lvs->depth[xp] + 1;
+    if (!fill_eye(evs, y, k, &pp))
+        return zero;
+    int32_t v = xp;
+    for (int i = k - 1; i >= 0; i--, v = lvs->parent[v]) {
+        pp.pl[i] = lvs->pdf_fwd[v];
+        pp.pe[i] = lvs->pdf_rev[v];
+        pp.delta[i] = i > 0 && (lvs->flags[v] & CDL_V_DELTA) != 0;
+    }
+    int32_t x0 = xp;
+    while (lvs->parent[x0] >= 0)
+        x0 = lvs->parent[x0];
+    pp.s0 = !(lvs->flags[x0] & CDL_V_DELTA_LIGHT);
+    /* densities through the new edge x_{k-1} -> y, both ways */
+    pp.pl[k] = cdl_pdf_to_area(p_sa, px, py, evs->ng[y]);
+    if (k + 1 < pp.n)
+        pp.pl[k + 1] = cdl_vertex_pdf(&g->cx, evs, y, px, to_y, point_normal(evs, (uint32_t)ye));
+    pp.pe[k - 1] = cdl_vertex_pdf(&g->cx, evs, y, to_y, px, point_normal(lvs, (uint32_t)xp));
+    if (k >= 2)
+        pp.pe[k - 2] = cdl_vertex_pdf(&g->cx, lvs, (uint32_t)xp, py, from_x, point_normal(lvs, (uint32_t)xpp));
+    return cdl_scale(c, weight(g, &pp, k));
+}
+
+cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y)
+{
+    const cdl_vertex_store *evs = g->evs;
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    if (!(evs->flags[y] & CDL_V_EMITTER) || evs->light[y] < 0)
+        return zero;
+    const cdl_light *l = &g->cx.scene->lights[evs->light[y]];
+    cdl_vec3 Le = cdl_light_Le(l, evs->ng[y], evs->wi[y]);
+    if (cdl_is_black(Le))
+        return zero;
+    cdl_vec3 c = cdl_mul(evs->beta[y], Le);
+    path_pdfs pp;
+    if (!fill_eye(evs, y, 0, &pp))
+        return zero;
+    if (pp.n == 1)
+        return c; /* seen directly: nothing else samples it */
+    pp.s0 = 1;
+    pp.delta[0] = 0;
+    pp.pl[0] = cdl_light_pdf_origin(g->cx.scene, evs->light[y]);
+    int32_t z1 = evs->parent[y];
+    pp.pl[1] = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[y], evs->wi[y]), evs->p[y], evs->p[z1],
+                               point_normal(evs, (uint32_t)z1));
+    return cdl_scale(c, weight(g, &pp, 0));
+}

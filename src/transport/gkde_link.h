@@ -1,0 +1,71 @@
+/* The generalized kernel estimator of Bekaert et al. 2003 (gkde): links
+ * between a light vertex x_k's footprint sphere and an eye vertex y inside
+ * it, scored with the true BSDFs, cosines and visibility of the edge from
+ * x_k's parent x_{k-1} to y (eq. 4, 8), weighted against the other ways
+ * the same path could have been sampled (eq. 9, generalized) and
+ * subsampled by stratified trial linking (eq. 10).
+ *
+ * A full path is z_0 (on a light) ... z_{n-1} (the first eye vertex y_1;
+ * the camera is left out: every strategy shares it). Merging at z_j takes
+ * the light subpath z_0 .. z_{j-1} plus a light vertex landing near z_j,
+ * and the eye subpath from the camera down to z_j. */
+#ifndef CDL_GKDE_LINK_H
+#define CDL_GKDE_LINK_H
+
+#include <math.h>
+
+#include "transport/connect.h"
+
+/* Footprint radius of eq. 7 from the light-side area density p of a
+ * vertex and its parent's radius: h / sqrt(p) + R_parent. A vertex after a
+ * specular bounce (p = 0: a Dirac density) adds nothing of its own. */
+static inline float cdl_footprint_radius(float h, float pdf_area, float r_parent)
+{
+    return (pdf_area > 0.0f ? h / sqrtf(pdf_area) : 0.0f) + r_parent;
+}
+
+/* Stratified sampling of a discrete pdf (eq. 10, §5): m draws from the
+ * weights a_i / W of one eye vertex's candidates, visited in a fixed
+ * order, with a single offset u in [0, 1). Candidate i is drawn
+ * floor(C_i + u) - floor(C_{i-1} + u) times, C_i = m (a_1 + .. + a_i) / W:
+ * in expectation m a_i / W times, never more than one draw away from it. */
+typedef struct cdl_strat {
+    double scale; /* m / W */
+    double cum;   /* C of the candidates so far, plus u */
+} cdl_strat;
+
+static inline void cdl_strat_init(cdl_strat *s, double m, double wsum, double u)
+{
+    s->scale = wsum > 0.0 ? m / wsum : 0.0;
+    s->cum = u;
+}
+
+/* Draws of the next candidate (weight a). */
+static inline uint32_t cdl_strat_next(cdl_strat *s, double a)
+{
+    double before = floor(s->cum);
+    s->cum += a * s->scale;
+    return (uint32_t)(floor(s->cum) - before);
+}
+
+/* What scoring a link needs besides the two stores. */
+typedef struct cdl_gkde_ctx {
+    cdl_connect_ctx cx;
+    const cdl_vertex_store *lvs, *evs;
+    const float *radius; /* footprint radius of each light vertex */
+    float h;             /* bandwidth (eq. 7) */
+    float n_light;       /* light paths per step: the merge strategies' sample count */
+} cdl_gkde_ctx;
+
+/* Score of the link (light vertex xk, eye vertex y) if the edge from
+ * xk's parent to y is unoccluded: partial light score x partial eye score
+ * x (8a) x (8b), times the strategy weight; per light path (the caller
+ * divides by nothing more than the acceptance probability). Black when
+ * the link cannot carry light (a BSDF or cosine is zero). */
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y);
+
+/* Emission an eye vertex y lying on an area light collects (the eye path
+ * alone), times its weight against the merges of the same path. */
+cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y);
+
+#endif
