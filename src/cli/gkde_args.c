@@ -5,7 +5,7 @@
 
 #include "cli/args.h"
 
-static const char *valued[] = {"--eye-paths", "--links", "--bandwidth", "--path-memory"};
+static const char *valued[] = {"--eye-paths", "--links", "--bandwidth", "--path-memory", "--footprint-cap"};
 
 int cdl_gkde_arg_kind(const char *o)
 {
@@ -29,6 +29,9 @@ int cdl_gkde_arg(const char *o, const char *v, cdl_gkde_options *g, cdl_error *e
     } else if (!strcmp(o, "--bandwidth")) {
         rc = cdl_arg_float(o, v, 1e-9, 1e3, &d, err);
         g->bandwidth = (float)d;
+    } else if (!strcmp(o, "--footprint-cap")) {
+        rc = cdl_arg_float(o, v, 0.0, 1e6, &d, err);
+        g->footprint_cap = (float)d;
     } else if (!strcmp(o, "--path-memory")) {
         rc = cdl_arg_int(o, v, 1, 1048576, &l, err);
         g->max_mib = (uint32_t)l;
@@ -45,6 +48,8 @@ void cdl_gkde_args_help(void)
            "      --bandwidth h       footprint bandwidth of eq. 7 (default: calibrated in\n"
            "                          the first step so that an eye vertex lies in about M\n"
            "                          first-bounce footprints)\n"
+           "      --footprint-cap F   footprint radii at most F times the median\n"
+           "                          first-bounce one (default 2; 0: eq. 7 unbounded)\n"
            "      --path-memory MiB   cap on the stored light and eye vertices (default 4096)\n"
            "\n");
 }

@@ -25,6 +25,7 @@
  * in light-vertex order, so sums and the stratified draws never depend on
  * scheduling. */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,12 +38,15 @@
 #include "transport/subpath.h"
 
 #define LIGHT_CHUNK 1024
-#define SEG_DEPTH 5     /* 2^5 subtrees (and 31 single points above them) */
+#define SEG_MAX_DEPTH 10 /* at most 2^10 subtrees */
 #define SEG_MIN 256
 #define MAX_BUNDLE 4096 /* links per footprint and subtree traced at once */
 
+/* A part of the eye points one thread owns: a kd subtree, plus the
+ * points of the nodes above it whose right subtree starts here. */
 typedef struct seg {
     uint32_t lo, hi;
+    uint32_t extra[SEG_MAX_DEPTH], nextra;
     float bmin[3], bmax[3];
 } seg;
 
@@ -58,7 +62,7 @@ typedef struct gkde_state {
     cdl_options opt;
     cdl_walk walk;
     uint32_t n_light, eye_paths, M;
-    float h;
+    float h, r_cap;
     int have_h;
     cdl_vertex_store lvs, evs;
     cdl_vertex_store *chunks; /* per row (eye) or per LIGHT_CHUNK paths (light), reused */
@@ -73,6 +77,14 @@ typedef struct gkde_state {
     cdl_kdtree kd;
     seg *segs;
     uint32_t nseg;
+    /* per part: the candidates of stage 3 as records (light vertex list
+     * index, count, points), replayed by stage 4 without a second query */
+    struct rec_buf {
+        uint32_t *v;
+        size_t n, cap;
+        int fail;
+    } *rec;
+    uint32_t nrec;
     /* per point */
     uint32_t *count, *tested, *unocc;
     double *wsum, *scale, *cum;
@@ -80,6 +92,7 @@ typedef struct gkde_state {
     /* per pixel: tested and unoccluded links in earlier steps, by eye depth 1, 2, 3+ */
     uint32_t *pv;
     cdl_vec3 *pixsum;
+    size_t rec_bytes;
     cdl_gkde_ctx g;
     gkde_stats st;
 } gkde_state;
@@ -147,7 +160,7 @@ static int chunks_reserve(gkde_state *s, uint32_t n, cdl_error *err)
 
 static size_t stored_bytes(const gkde_state *s)
 {
-    return cdl_vs_bytes(&s->lvs) + cdl_vs_bytes(&s->evs) + (size_t)s->evs.cap * sizeof *s->epix +
+    return s->rec_bytes + cdl_vs_bytes(&s->lvs) + cdl_vs_bytes(&s->evs) + (size_t)s->evs.cap * sizeof *s->epix +
            (size_t)s->lvs.cap * (sizeof *s->radius + sizeof *s->lv) +
            (size_t)s->npts * (4 * sizeof(float) + 5 + 3 * sizeof(uint32_t) + 3 * sizeof(double) +
                               sizeof(cdl_vec3));
@@ -281,7 +294,7 @@ static int footprints(gkde_state *s, float h, cdl_error *err)
     s->nlv = 0;
     for (uint32_t i = 0; i < l->n; i++) {
         int32_t p = l->parent[i];
-        r[i] = p < 0 ? 0.0f : cdl_footprint_radius(h, l->pdf_fwd[i], r[p]);
+        r[i] = p < 0 ? 0.0f : cdl_footprint_radius(h, l->pdf_fwd[i], r[p], s->r_cap);
         if (p >= 0 && !(l->flags[p] & CDL_V_DELTA) && l->depth[i] <= s->opt.maxdepth && r[i] > 0.0f &&
             isfinite(r[i]))
             lv[s->nlv++] = i;
@@ -289,35 +302,58 @@ static int footprints(gkde_state *s, float h, cdl_error *err)
     return 0;
 }
 
-static void add_seg(gkde_state *s, uint32_t lo, uint32_t hi)
+static void grow_box(seg *g, const float *p)
+{
+    for (int a = 0; a < 3; a++) {
+        g->bmin[a] = p[a] < g->bmin[a] ? p[a] : g->bmin[a];
+        g->bmax[a] = p[a] > g->bmax[a] ? p[a] : g->bmax[a];
+    }
+}
+
+static void add_seg(gkde_state *s, uint32_t lo, uint32_t hi, const uint32_t *extra, uint32_t nextra)
 {
     seg *g = &s->segs[s->nseg++];
     g->lo = lo;
     g->hi = hi;
+    g->nextra = nextra;
     for (int a = 0; a < 3; a++) {
         g->bmin[a] = INFINITY;
         g->bmax[a] = -INFINITY;
     }
     for (uint32_t q = lo; q < hi; q++)
-        for (int a = 0; a < 3; a++) {
-            float c = s->pts[4 * (size_t)q + (size_t)a];
-            g->bmin[a] = c < g->bmin[a] ? c : g->bmin[a];
-            g->bmax[a] = c > g->bmax[a] ? c : g->bmax[a];
-        }
+        grow_box(g, &s->pts[4 * (size_t)q]);
+    for (uint32_t i = 0; i < nextra; i++) {
+        g->extra[i] = extra[i];
+        grow_box(g, &s->pts[4 * (size_t)extra[i]]);
+    }
 }
 
-static void make_segs(gkde_state *s, uint32_t lo, uint32_t hi, int depth)
+/* Subtrees of [lo, hi) down to `depth` levels; the node points above
+ * them join the first subtree after them (pend: those waiting). */
+static void make_segs(gkde_state *s, uint32_t lo, uint32_t hi, int depth, const uint32_t *pend,
+                      uint32_t npend)
 {
     if (lo >= hi)
         return;
-    if (hi - lo <= SEG_MIN || depth == SEG_DEPTH) {
-        add_seg(s, lo, hi);
+    if (hi - lo <= SEG_MIN || depth == 0) {
+        add_seg(s, lo, hi, pend, npend);
         return;
     }
     uint32_t mid = lo + (hi - lo) / 2;
-    add_seg(s, mid, mid + 1);
-    make_segs(s, lo, mid, depth + 1);
-    make_segs(s, mid + 1, hi, depth + 1);
+    make_segs(s, lo, mid, depth - 1, pend, npend);
+    make_segs(s, mid + 1, hi, depth - 1, &mid, 1);
+}
+
+/* The points of g within distance sqrt(r2) of c, subtree first. */
+static void seg_ball(const gkde_state *s, const seg *g, cdl_vec3 c, float r2, cdl_kd_visit fn, void *ctx)
+{
+    cdl_kd_ball_range(&s->kd, g->lo, g->hi, c, r2, fn, ctx);
+    for (uint32_t i = 0; i < g->nextra; i++) {
+        const float *p = &s->pts[4 * (size_t)g->extra[i]];
+        float dx = p[0] - c.x, dy = p[1] - c.y, dz = p[2] - c.z, d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 <= r2)
+            fn(ctx, g->extra[i], d2);
+    }
 }
 
 static int sphere_meets(const seg *g, cdl_vec3 c, float r)
@@ -381,11 +417,23 @@ static int build_points(gkde_state *s, cdl_error *err)
     GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc)
 #undef GROW
     free(s->segs);
-    s->segs = malloc(sizeof(seg) * (2u << SEG_DEPTH));
+    /* about four parts per thread; results do not depend on the split */
+    int depth = 1;
+    while (depth < SEG_MAX_DEPTH && (1 << depth) < 4 * omp_get_max_threads())
+        depth++;
+    s->segs = malloc(sizeof(seg) << depth);
     if (!s->segs)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
     s->nseg = 0;
-    make_segs(s, 0, n, 0);
+    make_segs(s, 0, n, depth, NULL, 0);
+    if (s->nseg > s->nrec) {
+        struct rec_buf *r = realloc(s->rec, sizeof *r * s->nseg);
+        if (!r)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
+        memset(r + s->nrec, 0, sizeof *r * (s->nseg - s->nrec));
+        s->rec = r;
+        s->nrec = s->nseg;
+    }
     return 0;
 }
 
@@ -426,6 +474,36 @@ static void calibrate(gkde_state *s)
     s->have_h = 1;
 }
 
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* The footprint cap: --footprint-cap times the median first-bounce radius.
+ * Eq. 7 grows footprints by R_1 or so at every bounce; deep ones then
+ * cover thousands of eye vertices to be counted, of which eq. 10 keeps
+ * almost none, and their disc normalization is the worst. */
+static void set_cap(gkde_state *s)
+{
+    s->r_cap = INFINITY;
+    float f = s->opt.gkde.footprint_cap;
+    const cdl_vertex_store *l = &s->lvs;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < l->n; i++)
+        n += l->depth[i] == 1 && l->pdf_fwd[i] > 0.0f;
+    float *r = n && f > 0.0f ? malloc(sizeof(float) * n) : NULL;
+    if (!r)
+        return;
+    n = 0;
+    for (uint32_t i = 0; i < l->n; i++)
+        if (l->depth[i] == 1 && l->pdf_fwd[i] > 0.0f)
+            r[n++] = s->h / sqrtf(l->pdf_fwd[i]);
+    qsort(r, n, sizeof *r, cmp_float);
+    s->r_cap = f * r[n / 2];
+    free(r);
+}
+
 static float accept_weight(const gkde_state *s, uint32_t xk)
 {
     const cdl_vertex_store *l = &s->lvs;
@@ -438,14 +516,31 @@ typedef struct count_ctx {
     gkde_state *s;
     double a;
     int max_eye_depth;
+    struct rec_buf *r;
 } count_ctx;
+
+static int rec_push(struct rec_buf *r, uint32_t v)
+{
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 1 << 16;
+        uint32_t *p = realloc(r->v, cap * sizeof *p);
+        if (!p) {
+            r->fail = 1;
+            return -1;
+        }
+        r->v = p;
+        r->cap = cap;
+    }
+    r->v[r->n++] = v;
+    return 0;
+}
 
 static void count_cb(void *ctx, uint32_t q, float d2)
 {
     (void)d2;
     count_ctx *c = ctx;
     gkde_state *s = c->s;
-    if ((int)s->evs.depth[point_vertex(s, q)] > c->max_eye_depth)
+    if ((int)s->evs.depth[point_vertex(s, q)] > c->max_eye_depth || rec_push(c->r, q))
         return;
     s->count[q]++;
     s->wsum[q] += c->a;
@@ -461,7 +556,6 @@ typedef struct bundle {
 typedef struct link_ctx {
     gkde_state *s;
     double a;
-    int max_eye_depth;
     uint32_t n, q[MAX_BUNDLE];
     float w[MAX_BUNDLE];
     uint64_t trials;
@@ -472,13 +566,10 @@ typedef struct link_ctx {
 
 static void score_links(gkde_state *s, link_ctx *lc);
 
-static void link_cb(void *ctx, uint32_t q, float d2)
+/* Stage 4 for candidate q of the current footprint: its stratified draws. */
+static void link_point(link_ctx *c, uint32_t q)
 {
-    (void)d2;
-    link_ctx *c = ctx;
     gkde_state *s = c->s;
-    if ((int)s->evs.depth[point_vertex(s, q)] > c->max_eye_depth)
-        return;
     float w = 1.0f;
     if (s->scale[q] > 0.0) {
         cdl_strat st = {s->scale[q], s->cum[q]};
@@ -498,8 +589,6 @@ static void link_cb(void *ctx, uint32_t q, float d2)
     c->trials++;
 }
 
-
-/* The links of footprint xk within one subtree: visibility and scores. */
 static void score_links(gkde_state *s, link_ctx *lc)
 {
     const cdl_vertex_store *l = &s->lvs, *e = &s->evs;
@@ -570,17 +659,38 @@ static uint64_t link_all(gkde_state *s, uint32_t pass)
             s->count[q] = 0;
             s->wsum[q] = 0.0;
         }
-        count_ctx c = {s, 0.0, 0};
-        for (uint32_t a = 0; a < s->nlv; a++) {
+        for (uint32_t i = 0; i < sg->nextra; i++) {
+            s->count[sg->extra[i]] = 0;
+            s->wsum[sg->extra[i]] = 0.0;
+        }
+        struct rec_buf *r = &s->rec[g];
+        r->n = 0;
+        r->fail = 0;
+        count_ctx c = {s, 0.0, 0, r};
+        for (uint32_t a = 0; a < s->nlv && !r->fail; a++) {
             uint32_t xk = s->lv[a];
             float R = s->radius[xk];
             if (!sphere_meets(sg, s->lvs.p[xk], R))
                 continue;
             c.a = accept_weight(s, xk);
             c.max_eye_depth = s->opt.maxdepth - (int)s->lvs.depth[xk] + 1;
-            cdl_kd_ball_range(&s->kd, sg->lo, sg->hi, s->lvs.p[xk], R * R, count_cb, &c);
+            size_t at = r->n;
+            if (rec_push(r, a) || rec_push(r, 0))
+                break;
+            seg_ball(s, sg, s->lvs.p[xk], R * R, count_cb, &c);
+            if (r->n == at + 2)
+                r->n = at; /* none */
+            else
+                r->v[at + 1] = (uint32_t)(r->n - at - 2);
         }
     }
+    size_t rec_bytes = 0;
+    for (uint32_t g = 0; g < s->nseg; g++) {
+        if (s->rec[g].fail)
+            return UINT64_MAX;
+        rec_bytes += s->rec[g].cap * sizeof(uint32_t);
+    }
+    s->rec_bytes = rec_bytes;
     /* stage 4's plan: M / P_vis draws, or every candidate */
     double cand = 0.0;
     for (uint32_t q = 0; q < n; q++) {
@@ -613,26 +723,28 @@ static uint64_t link_all(gkde_state *s, uint32_t pass)
             lc->trials = 0;
             lc->b = b;
             lc->t_score = lc->t_rays = 0.0;
-            for (uint32_t a = 0; a < s->nlv; a++) {
-                uint32_t xk = s->lv[a];
-                float R = s->radius[xk];
-                if (!sphere_meets(sg, s->lvs.p[xk], R))
-                    continue;
-                double ta = cdl_time_now(), before = lc->t_score + lc->t_rays;
+            double ta = cdl_time_now();
+            const struct rec_buf *r = &s->rec[g];
+            for (size_t i = 0; i < r->n;) {
+                uint32_t xk = s->lv[r->v[i]], c = r->v[i + 1];
+                const uint32_t *qs = &r->v[i + 2];
+                i += 2 + (size_t)c;
                 lc->a = accept_weight(s, xk);
-                lc->max_eye_depth = s->opt.maxdepth - (int)s->lvs.depth[xk] + 1;
                 lc->n = 0;
                 lc->xk = xk;
-                cdl_kd_ball_range(&s->kd, sg->lo, sg->hi, s->lvs.p[xk], R * R, link_cb, lc);
-                t_link += cdl_time_now() - ta - (lc->t_score + lc->t_rays - before);
+                for (uint32_t j = 0; j < c; j++)
+                    link_point(lc, qs[j]);
                 if (lc->n)
                     score_links(s, lc);
             }
+            t_link += cdl_time_now() - ta - lc->t_score - lc->t_rays;
             t_score += lc->t_score;
             t_rays += lc->t_rays;
             trials += lc->trials;
             for (uint32_t q = sg->lo; q < sg->hi; q++)
                 rays += s->tested[q];
+            for (uint32_t i = 0; i < sg->nextra; i++)
+                rays += s->tested[sg->extra[i]];
         }
         free(lc);
         free(b);
@@ -663,7 +775,10 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
         return rc;
     if (!s->have_h)
         calibrate(s);
+    if (!(s->r_cap > 0.0f))
+        set_cap(s);
     s->g.h = s->h;
+    s->g.r_cap = s->r_cap;
     rc = footprints(s, s->h, err);
     if (rc)
         return rc;
@@ -671,7 +786,13 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     s->g.evs = &s->evs;
     s->g.radius = s->radius;
     s->st.t_count += cdl_time_now() - t2;
-    film->rays += link_all(s, pass);
+    uint64_t lr = link_all(s, pass);
+    if (lr == UINT64_MAX)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory for candidate links");
+    film->rays += lr;
+    rc = check_memory(s, err);
+    if (rc)
+        return rc;
     if (cdl_cancel)
         return 0; /* an interrupted step adds nothing */
     /* the step's image: links per eye vertex, emitters the eye paths hit */
@@ -739,6 +860,9 @@ static void gkde_destroy(void *self)
     cdl_kd_free(&s->kd);
     free(s->pts);
     free(s->segs);
+    for (uint32_t i = 0; i < s->nrec; i++)
+        free(s->rec[i].v);
+    free(s->rec);
     free(s->count);
     free(s->tested);
     free(s->unocc);

@@ -35,6 +35,7 @@ void cdl_options_default(cdl_options *o)
     o->pm.shadow_rays = 4;
     o->gkde.eye_paths = 1;
     o->gkde.links = 10;
+    o->gkde.footprint_cap = 2.0f;
     o->gkde.max_mib = 4096;
 }
 

@@ -45,7 +45,7 @@ static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
         best = ld[0];
     for (int j = 1; j < n; j++) {
         lpl += log1(pp->pl[j]);
-        r = cdl_footprint_radius(g->h, pp->pl[j], r);
+        r = cdl_footprint_radius(g->h, pp->pl[j], r, g->r_cap);
         ok[j] = !pp->delta[j] && !pp->delta[j - 1] && r > 0.0f;
         ld[j] = lpl + lsum_pe[j] + lnpi + 2.0 * log((double)r);
         if (ok[j] && ld[j] > best)
@@ -110,7 +110,8 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y)
     float R = g->radius[xk];
     float kern = cos_x * cos_y / (CDL_PI * R * R * cos_k * p_sa);
     cdl_vec3 c = cdl_mul(cdl_mul(lvs->beta[xp], fl), cdl_mul(fe, evs->beta[y]));
-    c = cdl_scale(c, kern / g->n_light);
+    /* x_k exists only if the light path survived Russian roulette at x_{k-1} */
+    c = cdl_scale(c, kern / (g->n_light * lvs->rr[xp]));
     if (cdl_is_black(c) || !cdl_is_finite3(c))
         return zero;
 

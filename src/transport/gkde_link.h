@@ -17,11 +17,13 @@
 #include "transport/connect.h"
 
 /* Footprint radius of eq. 7 from the light-side area density p of a
- * vertex and its parent's radius: h / sqrt(p) + R_parent. A vertex after a
- * specular bounce (p = 0: a Dirac density) adds nothing of its own. */
-static inline float cdl_footprint_radius(float h, float pdf_area, float r_parent)
+ * vertex and its parent's radius: h / sqrt(p) + R_parent, at most cap. A
+ * vertex after a specular bounce (p = 0: a Dirac density) adds nothing of
+ * its own. */
+static inline float cdl_footprint_radius(float h, float pdf_area, float r_parent, float cap)
 {
-    return (pdf_area > 0.0f ? h / sqrtf(pdf_area) : 0.0f) + r_parent;
+    float r = (pdf_area > 0.0f ? h / sqrtf(pdf_area) : 0.0f) + r_parent;
+    return r < cap ? r : cap;
 }
 
 /* Stratified sampling of a discrete pdf (eq. 10, §5): m draws from the
@@ -54,6 +56,7 @@ typedef struct cdl_gkde_ctx {
     const cdl_vertex_store *lvs, *evs;
     const float *radius; /* footprint radius of each light vertex */
     float h;             /* bandwidth (eq. 7) */
+    float r_cap;         /* largest footprint radius */
     float n_light;       /* light paths per step: the merge strategies' sample count */
 } cdl_gkde_ctx;
 

@@ -36,6 +36,7 @@ static uint32_t push(cdl_vertex_store *vs)
     vs->flags[i] = 0;
     vs->light[i] = -1;
     vs->pdf_rev[i] = 0.0f;
+    vs->rr[i] = 1.0f;
     vs->u[i] = vs->v[i] = 0.0f;
     vs->mat[i] = 0;
     return i;
@@ -102,6 +103,7 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
             float q = cdl_minf(1.0f, cdl_max3(w));
             if (cdl_sampler_cheap(smp) >= q)
                 return;
+            vs->rr[i] = q;
             beta = cdl_scale(beta, 1.0f / q);
         }
         if (cdl_is_black(beta))

@@ -6,7 +6,7 @@
 void cdl_vs_init(cdl_vertex_store *vs) { memset(vs, 0, sizeof *vs); }
 
 #define VS_FIELDS(X)                                                                               \
-    X(p) X(ns) X(ng) X(wi) X(beta) X(pdf_fwd) X(pdf_rev) X(u) X(v) X(parent) X(mat) X(light)     \
+    X(p) X(ns) X(ng) X(wi) X(beta) X(pdf_fwd) X(pdf_rev) X(rr) X(u) X(v) X(parent) X(mat) X(light) \
     X(depth) X(flags)
 
 void cdl_vs_free(cdl_vertex_store *vs)

@@ -25,7 +25,10 @@ typedef struct cdl_vertex_store {
     cdl_vec3 *wi;          /* unit direction towards the previous vertex */
     cdl_vec3 *beta;        /* throughput up to and including this vertex */
     float *pdf_fwd;        /* area density of this vertex from its predecessor */
-    float *pdf_rev;        /* area density of the predecessor from this vertex */
+    float *pdf_rev;        /* area density of this vertex sampled from its successor */
+    float *rr;             /* probability the walk went on past this vertex (Russian
+                              roulette; 1 without): a method that uses the successor's
+                              existence (gkde's footprints) divides by it */
     float *u, *v;          /* texture coordinates (to rebuild the BSDF) */
     int32_t *parent;       /* previous vertex of the same path, -1 at the start */
     uint32_t *mat;
