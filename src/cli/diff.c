@@ -53,7 +53,9 @@ int cdl_cmd_diff(int argc, char **argv)
                    "Prints RMSE, relative MSE (mean of (t-r)^2/(r^2+0.01)), mean absolute\n"
                    "error and the ratio of image means; for images with rare fireflies also\n"
                    "the relative MSE without the largest 0.1%% of per-pixel terms and the\n"
-                   "median over 16x16 blocks of the ratio of block means. --heatmap writes a\n"
+                   "median over 16x16 blocks of the ratio of block means; block_dev32 is the\n"
+                   "RMS over 32x32 blocks of (block mean ratio - 1), a measure of bias.\n"
+                   "--heatmap writes a\n"
                    "false-colour map of the per-pixel relative error (log scale, 1e-4 blue\n"
                    "to 1 red). --region compares only the pixels x in [X0, X1), y in [Y0, Y1)\n"
                    "(y = 0 the top row), e.g. one room of an interior.\n");
@@ -112,9 +114,10 @@ int cdl_cmd_diff(int argc, char **argv)
         return cdl_report(&err);
     }
     printf("rmse %.6g  relmse %.6g  mae %.6g  mean_ratio %.6f  relmse_trimmed %.6g  "
-           "block_median_ratio %.6f  (mean test %.6g, ref %.6g)\n",
+           "block_median_ratio %.6f  block_dev32 %.6f  (mean test %.6g, ref %.6g)\n",
            m.rmse, m.relmse, m.mae, m.mean_ratio, m.relmse_trimmed,
-           cdl_image_block_median_ratio(&t, &r, 16), m.mean_test, m.mean_ref);
+           cdl_image_block_median_ratio(&t, &r, 16), cdl_image_block_rms_dev(&t, &r, 32), m.mean_test,
+           m.mean_ref);
     cdl_image_free(&t);
     cdl_image_free(&r);
     cdl_image_free(&h);

@@ -485,6 +485,12 @@ int cdl_cmd_render(int argc, char **argv)
     }
     cdl_kv meta[] = {{"integrator", a.integrator}, {"spp", s_spp}, {"seed", s_seed},
                      {"renderTime", s_time},       {"commandLine", cmdline}};
+    if (pass_failed && pass == 0) { /* nothing rendered: no image to write */
+        cdl_film_free(&film);
+        cdl_integrator_destroy(&integ);
+        cdl_scene_free(&scene);
+        return pass_failed;
+    }
     rc = cdl_film_resolve(&film, &img, &err);
     cdl_image aov_img[CDL_MAX_AOVS];
     cdl_layer layers[CDL_MAX_AOVS];

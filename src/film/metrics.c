@@ -120,16 +120,17 @@ int cdl_image_heatmap(const cdl_image *test, const cdl_image *ref,
     return 0;
 }
 
-double cdl_image_block_median_ratio(const cdl_image *test,
-                                    const cdl_image *ref, int bs)
+/* Ratios of block means (blocks with a dark or non-finite ratio left
+ * out) into a new array; *n their count. NULL on bad input. */
+static double *block_ratios(const cdl_image *test, const cdl_image *ref, int bs, size_t *count)
 {
     if (bs < 1 || same_size(test, ref, NULL))
-        return NAN;
+        return NULL;
     int w = test->width, h = test->height;
     size_t nbx = (w + bs - 1) / bs, nby = (h + bs - 1) / bs, n = 0;
     double *ratios = malloc(nbx * nby * sizeof *ratios);
     if (!ratios)
-        return NAN;
+        return NULL;
     for (int by = 0; by < h; by += bs)
         for (int bx = 0; bx < w; bx += bs) {
             double st = 0, sr = 0;
@@ -145,6 +146,17 @@ double cdl_image_block_median_ratio(const cdl_image *test,
             if (sr / cnt >= 1e-6 && isfinite(ratio))
                 ratios[n++] = ratio;
         }
+    *count = n;
+    return ratios;
+}
+
+double cdl_image_block_median_ratio(const cdl_image *test,
+                                    const cdl_image *ref, int bs)
+{
+    size_t n;
+    double *ratios = block_ratios(test, ref, bs, &n);
+    if (!ratios)
+        return NAN;
     double med = NAN;
     if (n > 0) {
         qsort(ratios, n, sizeof *ratios, cmp_double);
@@ -152,4 +164,16 @@ double cdl_image_block_median_ratio(const cdl_image *test,
     }
     free(ratios);
     return med;
+}
+
+double cdl_image_block_rms_dev(const cdl_image *test, const cdl_image *ref, int bs)
+{
+    size_t n;
+    double *ratios = block_ratios(test, ref, bs, &n), s = 0.0;
+    if (!ratios)
+        return NAN;
+    for (size_t i = 0; i < n; i++)
+        s += (ratios[i] - 1.0) * (ratios[i] - 1.0);
+    free(ratios);
+    return n ? sqrt(s / (double)n) : NAN;
 }

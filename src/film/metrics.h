@@ -33,4 +33,8 @@ int cdl_image_heatmap(const cdl_image *test, const cdl_image *ref,
 double cdl_image_block_median_ratio(const cdl_image *test,
                                     const cdl_image *ref, int bs);
 
+/* Root mean square over the same blocks of (ratio - 1): a bias measure
+ * once the per-pixel noise averages out within a block. */
+double cdl_image_block_rms_dev(const cdl_image *test, const cdl_image *ref, int bs);
+
 #endif
