@@ -604,9 +604,11 @@ static void score_links(gkde_state *s, link_ctx *lc)
         if (li->type == CDL_LIGHT_SPHERE)
             skip = li->prim;
     }
+    cdl_gkde_parent par;
+    cdl_gkde_parent_init(&s->g, xk, &par);
     for (uint32_t i = 0; i < lc->n; i++) {
         uint32_t q = lc->q[i], y = point_vertex(s, q);
-        cdl_vec3 c = cdl_gkde_link(&s->g, xk, y);
+        cdl_vec3 c = cdl_gkde_link(&s->g, &par, y);
         if (cdl_is_black(c))
             continue;
         cdl_vec3 d = cdl_sub(e->p[y], px);

@@ -78,37 +78,93 @@ static int fill_eye(const cdl_vertex_store *evs, uint32_t y, int k, path_pdfs *p
     return 1;
 }
 
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y)
+static void vertex_init(const cdl_gkde_ctx *g, const cdl_vertex_store *vs, uint32_t i, cdl_gkde_vertex *v)
+{
+    v->vs = vs;
+    v->i = i;
+    v->light = (vs->flags[i] & CDL_V_LIGHT) ? &g->cx.scene->lights[vs->light[i]] : NULL;
+    if (!v->light)
+        cdl_vs_bsdf(g->cx.scene, vs, i, &v->b);
+}
+
+/* cdl_vertex_f on the built vertex. */
+static cdl_vec3 vertex_f(const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to, int light_side)
+{
+    const cdl_vertex_store *vs = v->vs;
+    cdl_vec3 p = vs->p[v->i], wt = cdl_normalize(cdl_sub(to, p));
+    if (v->light) {
+        float k = cdl_light_emit_factor(v->light, vs->ng[v->i], wt);
+        return cdl_v3(k, k, k);
+    }
+    cdl_vec3 wf = cdl_normalize(cdl_sub(from, p));
+    if (!light_side)
+        return cdl_bsdf_eval(&v->b, wf, wt, 0);
+    cdl_vec3 f = cdl_bsdf_eval(&v->b, wf, wt, 1);
+    float num = fabsf(cdl_dot(wf, vs->ns[v->i])) * fabsf(cdl_dot(wt, vs->ng[v->i]));
+    float den = fabsf(cdl_dot(wf, vs->ng[v->i])) * fabsf(cdl_dot(wt, vs->ns[v->i]));
+    return cdl_scale(f, den > 0.0f ? num / den : 0.0f);
+}
+
+/* cdl_vertex_pdf on the built vertex: area density at `to` (normal nt). */
+static float vertex_pdf(const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to, cdl_vec3 nt)
+{
+    cdl_vec3 p = v->vs->p[v->i], w = cdl_sub(to, p);
+    float len = cdl_length(w);
+    if (!(len > 0.0f))
+        return 0.0f;
+    w = cdl_scale(w, 1.0f / len);
+    float sa = v->light ? cdl_light_pdf_dir(v->light, v->vs->ng[v->i], w)
+                        : cdl_bsdf_pdf(&v->b, cdl_normalize(cdl_sub(from, p)), w);
+    return cdl_pdf_to_area(sa, p, to, nt);
+}
+
+void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *par)
+{
+    const cdl_vertex_store *lvs = g->lvs;
+    int32_t xp = lvs->parent[xk];
+    par->xk = xk;
+    par->ok = xp >= 0 && !(lvs->flags[xp] & CDL_V_DELTA);
+    if (!par->ok)
+        return;
+    vertex_init(g, lvs, (uint32_t)xp, &par->xp);
+    par->xpp = lvs->parent[xp];
+    par->from = par->xpp >= 0 ? lvs->p[par->xpp] : lvs->p[xp];
+    par->nx = (lvs->flags[xp] & CDL_V_DELTA_LIGHT) ? cdl_v3(0.0f, 0.0f, 0.0f) : lvs->ns[xp];
+    /* the footprint's disc seen from x_{k-1} (eq. 8b); a grazing x_k has
+     * a vanishing disc, kept finite */
+    par->cos_k = cdl_maxf(fabsf(cdl_dot(lvs->ng[xk], lvs->wi[xk])), 1e-3f);
+}
+
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y)
 {
     const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
     cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
-    int32_t xp = lvs->parent[xk];
-    if (xp < 0 || (lvs->flags[xp] & CDL_V_DELTA) || (evs->flags[y] & (CDL_V_DELTA | CDL_V_CAMERA)))
+    if (!par->ok || (evs->flags[y] & (CDL_V_DELTA | CDL_V_CAMERA)))
         return zero;
+    uint32_t xp = par->xp.i;
     cdl_vec3 px = lvs->p[xp], py = evs->p[y], d = cdl_sub(py, px);
     float r2 = cdl_dot(d, d);
     if (!(r2 > 0.0f))
         return zero;
     cdl_vec3 w = cdl_scale(d, 1.0f / sqrtf(r2));
-    int32_t xpp = lvs->parent[xp], ye = evs->parent[y];
-    cdl_vec3 from_x = xpp >= 0 ? lvs->p[xpp] : px, to_y = evs->p[ye];
-    cdl_vec3 fl = cdl_vertex_f(&g->cx, lvs, (uint32_t)xp, from_x, py, 1);
+    int32_t ye = evs->parent[y];
+    cdl_vec3 to_y = evs->p[ye];
+    cdl_vec3 fl = vertex_f(&par->xp, par->from, py, 1);
     if (cdl_is_black(fl))
         return zero;
-    cdl_vec3 fe = cdl_vertex_f(&g->cx, evs, y, px, to_y, 0);
+    cdl_gkde_vertex yv;
+    vertex_init(g, evs, y, &yv);
+    cdl_vec3 fe = vertex_f(&yv, px, to_y, 0);
     if (cdl_is_black(fe))
         return zero;
-    float p_sa = cdl_vertex_pdf_sa(&g->cx, lvs, (uint32_t)xp, from_x, w);
+    float p_sa = par->xp.light ? cdl_light_pdf_dir(par->xp.light, lvs->ng[xp], w)
+                               : cdl_bsdf_pdf(&par->xp.b, cdl_normalize(cdl_sub(par->from, px)), w);
     if (!(p_sa > 0.0f))
         return zero;
-    cdl_vec3 nx = (lvs->flags[xp] & CDL_V_DELTA_LIGHT) ? zero : lvs->ns[xp];
-    float cos_x = cdl_is_black(nx) ? 1.0f : fabsf(cdl_dot(nx, w));
+    float cos_x = cdl_is_black(par->nx) ? 1.0f : fabsf(cdl_dot(par->nx, w));
     float cos_y = fabsf(cdl_dot(evs->ns[y], w));
-    /* the footprint's disc seen from x_{k-1} (eq. 8b); a grazing x_k has
-     * a vanishing disc, kept finite */
-    float cos_k = cdl_maxf(fabsf(cdl_dot(lvs->ng[xk], lvs->wi[xk])), 1e-3f);
-    float R = g->radius[xk];
-    float kern = cos_x * cos_y / (CDL_PI * R * R * cos_k * p_sa);
+    float R = g->radius[par->xk];
+    float kern = cos_x * cos_y / (CDL_PI * R * R * par->cos_k * p_sa);
     cdl_vec3 c = cdl_mul(cdl_mul(lvs->beta[xp], fl), cdl_mul(fe, evs->beta[y]));
     /* x_k exists only if the light path survived Russian roulette at x_{k-1} */
     c = cdl_scale(c, kern / (g->n_light * lvs->rr[xp]));
@@ -120,23 +176,21 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y)
     int k = lvs->depth[xp] + 1;
     if (!fill_eye(evs, y, k, &pp))
         return zero;
-    int32_t v = xp;
+    int32_t v = (int32_t)xp, x0 = v;
     for (int i = k - 1; i >= 0; i--, v = lvs->parent[v]) {
         pp.pl[i] = lvs->pdf_fwd[v];
         pp.pe[i] = lvs->pdf_rev[v];
         pp.delta[i] = i > 0 && (lvs->flags[v] & CDL_V_DELTA) != 0;
+        x0 = v;
     }
-    int32_t x0 = xp;
-    while (lvs->parent[x0] >= 0)
-        x0 = lvs->parent[x0];
     pp.s0 = !(lvs->flags[x0] & CDL_V_DELTA_LIGHT);
     /* densities through the new edge x_{k-1} -> y, both ways */
     pp.pl[k] = cdl_pdf_to_area(p_sa, px, py, evs->ng[y]);
     if (k + 1 < pp.n)
-        pp.pl[k + 1] = cdl_vertex_pdf(&g->cx, evs, y, px, to_y, point_normal(evs, (uint32_t)ye));
-    pp.pe[k - 1] = cdl_vertex_pdf(&g->cx, evs, y, to_y, px, point_normal(lvs, (uint32_t)xp));
+        pp.pl[k + 1] = vertex_pdf(&yv, px, to_y, point_normal(evs, (uint32_t)ye));
+    pp.pe[k - 1] = vertex_pdf(&yv, to_y, px, point_normal(lvs, xp));
     if (k >= 2)
-        pp.pe[k - 2] = cdl_vertex_pdf(&g->cx, lvs, (uint32_t)xp, py, from_x, point_normal(lvs, (uint32_t)xpp));
+        pp.pe[k - 2] = vertex_pdf(&par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
     return cdl_scale(c, weight(g, &pp, k));
 }
 

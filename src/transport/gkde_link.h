@@ -60,12 +60,35 @@ typedef struct cdl_gkde_ctx {
     float n_light;       /* light paths per step: the merge strategies' sample count */
 } cdl_gkde_ctx;
 
-/* Score of the link (light vertex xk, eye vertex y) if the edge from
- * xk's parent to y is unoccluded: partial light score x partial eye score
- * x (8a) x (8b), times the strategy weight; per light path (the caller
+/* A vertex with its scattering function built once: a light path's
+ * start (the emission distribution) or a surface (the BSDF). */
+typedef struct cdl_gkde_vertex {
+    const cdl_vertex_store *vs;
+    uint32_t i;
+    const cdl_light *light; /* y_0 of a light path, else NULL */
+    cdl_bsdf b;
+} cdl_gkde_vertex;
+
+/* What the links of one footprint share: x_k, its parent x_{k-1} (with
+ * its BSDF) and the parent's own predecessor. */
+typedef struct cdl_gkde_parent {
+    uint32_t xk;
+    int32_t xpp;          /* x_{k-2}, or -1 */
+    cdl_gkde_vertex xp;
+    cdl_vec3 from;        /* position of x_{k-2} (x_{k-1} itself at a light) */
+    cdl_vec3 nx;          /* shading normal of x_{k-1}; zero for point lights */
+    float cos_k;          /* at x_k towards x_{k-1} */
+    int ok;               /* x_{k-1} can be linked from */
+} cdl_gkde_parent;
+
+void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *par);
+
+/* Score of the link (footprint of par->xk, eye vertex y) if the edge from
+ * x_{k-1} to y is unoccluded: partial light score x partial eye score x
+ * (8a) x (8b), times the strategy weight, per light path (the caller
  * divides by nothing more than the acceptance probability). Black when
  * the link cannot carry light (a BSDF or cosine is zero). */
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, uint32_t xk, uint32_t y);
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y);
 
 /* Emission an eye vertex y lying on an area light collects (the eye path
  * alone), times its weight against the merges of the same path. */
