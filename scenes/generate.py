@@ -727,6 +727,33 @@ def floor_many_lights():
     return s
 
 
+def grazing():
+    """Bekaert et al. 2003, Fig. 4: a planar blue light standing on a large
+    diffuse floor, tilted back by 10 degrees, so that the floor sees it at
+    grazing angles far away and is lit at grazing emission angles close to
+    it; a box in front casts a shadow (a silhouette). gkde's approximate
+    footprint normalization (§3) shows its bias here."""
+    s = Scene("grazing")
+    floor = s.material("floor", kd=(0.7, 0.7, 0.7))
+    crate = s.material("crate", kd=(0.6, 0.45, 0.3))
+    lamp = s.material("blue_light", kd=(0.0, 0.0, 0.0), ke=(10.0, 20.0, 60.0))
+    s.group("floor")
+    s.box((-5.0, -0.1, -3.0), (5.0, 0.0, 9.0), floor)
+    s.group("light")
+    a = math.radians(10.0)
+    h, w, y0 = 0.6, 2.0, 0.02
+    top = (h * math.cos(a), -h * math.sin(a))  # (dy, dz): leaning back (-z)
+    n = (0.0, math.sin(a), math.cos(a))  # front: towards +z, a little up
+    p = ((-w / 2, y0, 0.0), (w / 2, y0, 0.0), (w / 2, y0 + top[0], top[1]), (-w / 2, y0 + top[0], top[1]))
+    s.quad(p, n, lamp)
+    s.light_panels += 1
+    s.light_area += w * h
+    s.group("furniture")
+    s.box((0.6, 0.0, 1.2), (1.0, 0.4, 1.6), crate)
+    s.camera = ((0.0, 3.0, -1.2), (0.0, 0.0, 2.2), 60)
+    return s
+
+
 def caustic_ring():
     s = Scene("caustic_ring")
     R, H, T = 3.0, 2.0, 0.2       # room x, z in [-R, R], height H
@@ -754,6 +781,7 @@ SCENES = {
     "rooms10x10": rooms10x10,
     "doorslit": doorslit,
     "tworoom": tworoom,
+    "grazing": grazing,
     "floor_many_lights": floor_many_lights,
     "caustic_ring": caustic_ring,
 }

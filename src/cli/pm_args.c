@@ -102,8 +102,13 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
             pm->direct = CDL_DIRECT_LCON;
         else if (!strcmp(v, "lcon-biased"))
             pm->direct = CDL_DIRECT_LCON_BIASED;
+        else if (!strcmp(v, "photons"))
+            pm->direct_photons = 1;
         else
-            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power, lcon or lcon-biased, got '%s'", v);
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power, lcon, lcon-biased or photons, got '%s'",
+                                 v);
+        if (strcmp(v, "photons"))
+            pm->direct_photons = 0;
     }
     return rc;
 }
@@ -145,7 +150,9 @@ void cdl_pm_args_help(void)
            "      --importance-discard  drop photons with p < e instead (biased)\n"
            "      --direct KIND       power (default: lights in proportion to power), lcon\n"
            "                          (S rays to the lights of nearby primary photons, one to\n"
-           "                          the rest) or lcon-biased (none to the rest)\n"
+           "                          the rest), lcon-biased (none to the rest) or photons\n"
+           "                          (read from the photon map: its primary photons seen\n"
+           "                          directly; needs --gather 0)\n"
            "      --shadow-rays S     direct-light shadow rays per shading point (default 4)\n"
            "      --lcon-radius R     radius of the L_con query (default: --max-radius)\n"
            "      --photon-paths-max N  give up when N paths per pass have not stored\n"

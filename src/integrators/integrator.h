@@ -31,6 +31,7 @@ typedef struct cdl_pm_options {
     float caustic_ratio;    /* q (§2.2) */
     int caustic_random;     /* per-photon test against q instead of the path prefix */
     int direct;             /* cdl_direct_kind */
+    int direct_photons;     /* direct light from the map's primary photons (needs gather 0) */
     uint32_t shadow_rays;   /* S */
     float lcon_radius;      /* L_con query radius; <= 0: the maximum radius */
     uint64_t max_paths;     /* photon paths per pass before giving up; 0: 1000 per photon */

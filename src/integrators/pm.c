@@ -118,6 +118,9 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
         return cdl_error_set(err, CDL_ERR_USAGE, "--caustic-ratio", 0, "must be in (0, 1]");
     if (!(opt->pm.eps > 0.0f && opt->pm.eps <= 1.0f))
         return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in (0, 1]");
+    if (opt->pm.direct_photons && opt->pm.gather)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--direct", 0,
+                             "photons (direct light read from the photon map) needs --gather 0");
     if (opt->pm.precompute == 1)
         return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
                              "must be 0 (off) or at least 2: the photons that carry irradiance points "
@@ -232,6 +235,17 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
         }
         if (depth >= st->opt.maxdepth)
             return L;
+        if (st->opt.pm.direct_photons) {
+            /* the photon map seen directly, its primary photons the direct
+             * light (Jensen's visualization; Bekaert et al. 2003, Fig. 1) */
+            cdl_pm_query q = w->qgx;
+            q.max_depth = (uint32_t)(st->opt.maxdepth - depth);
+            w->qcx.max_depth = q.max_depth;
+            cdl_vec3 Lp = cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b);
+            if (st->caustic.n)
+                Lp = cdl_add(Lp, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
+            return cdl_add(L, cdl_mul(beta, Lp));
+        }
         cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
         if (depth + 1 < st->opt.maxdepth) {
             /* --maxdepth counts the whole path: the photons here may have met
@@ -330,7 +344,7 @@ static int pm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *
     pm_state *st = self;
     /* direct light only (--maxdepth 1) reads no photon map but L_con's,
      * which the first pass built: no photons to trace */
-    if (st->traced_pass != pass && st->opt.maxdepth > 1) {
+    if (st->traced_pass != pass && (st->opt.maxdepth > 1 || st->opt.pm.direct_photons)) {
         int rc = trace(st, pass, &film->rays, err);
         if (rc)
             return rc;
