@@ -444,7 +444,7 @@ static void count_only(void *ctx, uint32_t q, float d2)
 
 /* Mean number of first-bounce footprints (radius h / sqrt(p(x_1))) an eye
  * point lies in. */
-static double overlaps(const gkde_state *s, float h)
+static double overlaps(const gkde_state *s, float h, float cap_unit)
 {
     const cdl_vertex_store *l = &s->lvs;
     uint64_t total = 0;
@@ -452,17 +452,17 @@ static double overlaps(const gkde_state *s, float h)
     for (int64_t i = 0; i < (int64_t)l->n; i++) {
         if (l->depth[i] != 1 || !(l->pdf_fwd[i] > 0.0f))
             continue;
-        float r = h / sqrtf(l->pdf_fwd[i]);
+        float u = 1.0f / sqrtf(l->pdf_fwd[i]), r = h * (u < cap_unit ? u : cap_unit);
         total += cdl_kd_ball(&s->kd, l->p[i], r * r, count_only, NULL);
     }
     return s->npts ? (double)total / (double)s->npts : 0.0;
 }
 
-static void calibrate(gkde_state *s)
+static void calibrate(gkde_state *s, float cap_unit)
 {
     double M = (double)s->M, h = sqrt(M / (CDL_PI * (double)s->n_light));
     for (int it = 0, good = 0; it < 8 && good < 2; it++) {
-        double c = overlaps(s, (float)h);
+        double c = overlaps(s, (float)h, cap_unit);
         if (!(c > 0.0)) {
             h *= 4.0;
             continue;
@@ -480,13 +480,13 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The footprint cap: --footprint-cap times the median first-bounce radius.
+/* The footprint cap in units of h: --footprint-cap times the median of
+ * 1 / sqrt(p(x_1)), so that the cap is that many median first-bounce radii.
  * Eq. 7 grows footprints by R_1 or so at every bounce; deep ones then
- * cover thousands of eye vertices to be counted, of which eq. 10 keeps
+ * cover hundreds of eye vertices to be counted, of which eq. 10 keeps
  * almost none, and their disc normalization is the worst. */
-static void set_cap(gkde_state *s)
+static float cap_unit(const gkde_state *s)
 {
-    s->r_cap = INFINITY;
     float f = s->opt.gkde.footprint_cap;
     const cdl_vertex_store *l = &s->lvs;
     uint32_t n = 0;
@@ -494,14 +494,15 @@ static void set_cap(gkde_state *s)
         n += l->depth[i] == 1 && l->pdf_fwd[i] > 0.0f;
     float *r = n && f > 0.0f ? malloc(sizeof(float) * n) : NULL;
     if (!r)
-        return;
+        return INFINITY;
     n = 0;
     for (uint32_t i = 0; i < l->n; i++)
         if (l->depth[i] == 1 && l->pdf_fwd[i] > 0.0f)
-            r[n++] = s->h / sqrtf(l->pdf_fwd[i]);
+            r[n++] = 1.0f / sqrtf(l->pdf_fwd[i]);
     qsort(r, n, sizeof *r, cmp_float);
-    s->r_cap = f * r[n / 2];
+    float u = f * r[n / 2];
     free(r);
+    return u;
 }
 
 static float accept_weight(const gkde_state *s, uint32_t xk)
@@ -775,10 +776,12 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
         rc = check_memory(s, err);
     if (rc || cdl_cancel)
         return rc;
-    if (!s->have_h)
-        calibrate(s);
-    if (!(s->r_cap > 0.0f))
-        set_cap(s);
+    if (!(s->r_cap > 0.0f)) { /* the first step fixes h and the cap */
+        float u = cap_unit(s);
+        if (!s->have_h)
+            calibrate(s, u);
+        s->r_cap = s->h * u;
+    }
     s->g.h = s->h;
     s->g.r_cap = s->r_cap;
     rc = footprints(s, s->h, err);

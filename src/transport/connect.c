@@ -64,20 +64,26 @@ static cdl_vec3 vshading(const cdl_vertex_store *vs, uint32_t i)
     return vs->ns[i];
 }
 
+float cdl_vertex_pdf_sa_bsdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                             const cdl_bsdf *b, cdl_vec3 from, cdl_vec3 w)
+{
+    float pdf_sa;
+    if (vs->flags[i] & CDL_V_CAMERA)
+        cdl_camera_We(cx->cam, w, &pdf_sa);
+    else if (vs->flags[i] & CDL_V_LIGHT)
+        pdf_sa = cdl_light_pdf_dir(&cx->scene->lights[vs->light[i]], vs->ng[i], w);
+    else
+        pdf_sa = cdl_bsdf_pdf(b, cdl_normalize(cdl_sub(from, vs->p[i])), w);
+    return pdf_sa;
+}
+
 float cdl_vertex_pdf_sa(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
                         cdl_vec3 w)
 {
-    float pdf_sa;
-    if (vs->flags[i] & CDL_V_CAMERA) {
-        cdl_camera_We(cx->cam, w, &pdf_sa);
-    } else if (vs->flags[i] & CDL_V_LIGHT) {
-        pdf_sa = cdl_light_pdf_dir(&cx->scene->lights[vs->light[i]], vs->ng[i], w);
-    } else {
-        cdl_bsdf b;
+    cdl_bsdf b;
+    if (!(vs->flags[i] & (CDL_V_CAMERA | CDL_V_LIGHT)))
         cdl_vs_bsdf(cx->scene, vs, i, &b);
-        pdf_sa = cdl_bsdf_pdf(&b, cdl_normalize(cdl_sub(from, vs->p[i])), w);
-    }
-    return pdf_sa;
+    return cdl_vertex_pdf_sa_bsdf(cx, vs, i, &b, from, w);
 }
 
 float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
@@ -94,8 +100,8 @@ float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint
 /* f at vertex i for light arriving from `from` and leaving to `to` (eye
  * vertices: radiance mode; light vertices: importance mode with Veach's
  * shading-normal correction; y_0: the emission distribution). */
-cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
-                      cdl_vec3 from, cdl_vec3 to, int light_side)
+cdl_vec3 cdl_vertex_f_bsdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                           const cdl_bsdf *b, cdl_vec3 from, cdl_vec3 to, int light_side)
 {
     cdl_vec3 p = vs->p[i];
     cdl_vec3 wt = cdl_normalize(cdl_sub(to, p));
@@ -104,14 +110,21 @@ cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uin
         return cdl_v3(k, k, k);
     }
     cdl_vec3 wf = cdl_normalize(cdl_sub(from, p));
-    cdl_bsdf b;
-    cdl_vs_bsdf(cx->scene, vs, i, &b);
     if (!light_side)
-        return cdl_bsdf_eval(&b, wf, wt, 0);
-    cdl_vec3 f = cdl_bsdf_eval(&b, wf, wt, 1);
+        return cdl_bsdf_eval(b, wf, wt, 0);
+    cdl_vec3 f = cdl_bsdf_eval(b, wf, wt, 1);
     float num = fabsf(cdl_dot(wf, vs->ns[i])) * fabsf(cdl_dot(wt, vs->ng[i]));
     float den = fabsf(cdl_dot(wf, vs->ng[i])) * fabsf(cdl_dot(wt, vs->ns[i]));
     return cdl_scale(f, den > 0.0f ? num / den : 0.0f);
+}
+
+cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                      cdl_vec3 from, cdl_vec3 to, int light_side)
+{
+    cdl_bsdf b;
+    if (!(vs->flags[i] & CDL_V_LIGHT))
+        cdl_vs_bsdf(cx->scene, vs, i, &b);
+    return cdl_vertex_f_bsdf(cx, vs, i, &b, from, to, light_side);
 }
 
 /* Area density of next-event estimation choosing light point y (normal n)

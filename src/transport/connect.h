@@ -39,6 +39,10 @@ cdl_vec3 cdl_vertex_normal(const cdl_vertex_store *vs, uint32_t i);
  * the light's emission or the BSDF's. */
 float cdl_vertex_pdf_sa(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
                         cdl_vec3 w);
+/* The same with the vertex's BSDF already built (b: unused at the camera
+ * and at a light-path start): for callers that evaluate one vertex often. */
+float cdl_vertex_pdf_sa_bsdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                             const cdl_bsdf *b, cdl_vec3 from, cdl_vec3 w);
 /* The same as an area density at `to` (normal nt; zero: a point). */
 float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
                      cdl_vec3 to, cdl_vec3 nt);
@@ -49,6 +53,9 @@ float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint
  * emission distribution. */
 cdl_vec3 cdl_vertex_f(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
                       cdl_vec3 from, cdl_vec3 to, int light_side);
+/* The same with the vertex's BSDF already built (unused at a light-path start). */
+cdl_vec3 cdl_vertex_f_bsdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i,
+                           const cdl_bsdf *b, cdl_vec3 from, cdl_vec3 to, int light_side);
 
 /* G = |cos a| |cos b| / d^2 with geometric... shading normals na, nb
  * (zero normal: a point, cosine 1). */

@@ -87,34 +87,21 @@ static void vertex_init(const cdl_gkde_ctx *g, const cdl_vertex_store *vs, uint3
         cdl_vs_bsdf(g->cx.scene, vs, i, &v->b);
 }
 
-/* cdl_vertex_f on the built vertex. */
-static cdl_vec3 vertex_f(const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to, int light_side)
+static cdl_vec3 vertex_f(const cdl_gkde_ctx *g, const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to,
+                         int light_side)
 {
-    const cdl_vertex_store *vs = v->vs;
-    cdl_vec3 p = vs->p[v->i], wt = cdl_normalize(cdl_sub(to, p));
-    if (v->light) {
-        float k = cdl_light_emit_factor(v->light, vs->ng[v->i], wt);
-        return cdl_v3(k, k, k);
-    }
-    cdl_vec3 wf = cdl_normalize(cdl_sub(from, p));
-    if (!light_side)
-        return cdl_bsdf_eval(&v->b, wf, wt, 0);
-    cdl_vec3 f = cdl_bsdf_eval(&v->b, wf, wt, 1);
-    float num = fabsf(cdl_dot(wf, vs->ns[v->i])) * fabsf(cdl_dot(wt, vs->ng[v->i]));
-    float den = fabsf(cdl_dot(wf, vs->ng[v->i])) * fabsf(cdl_dot(wt, vs->ns[v->i]));
-    return cdl_scale(f, den > 0.0f ? num / den : 0.0f);
+    return cdl_vertex_f_bsdf(&g->cx, v->vs, v->i, &v->b, from, to, light_side);
 }
 
-/* cdl_vertex_pdf on the built vertex: area density at `to` (normal nt). */
-static float vertex_pdf(const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to, cdl_vec3 nt)
+/* Area density at `to` (normal nt) of sampling it from the built vertex. */
+static float vertex_pdf(const cdl_gkde_ctx *g, const cdl_gkde_vertex *v, cdl_vec3 from, cdl_vec3 to,
+                        cdl_vec3 nt)
 {
     cdl_vec3 p = v->vs->p[v->i], w = cdl_sub(to, p);
     float len = cdl_length(w);
     if (!(len > 0.0f))
         return 0.0f;
-    w = cdl_scale(w, 1.0f / len);
-    float sa = v->light ? cdl_light_pdf_dir(v->light, v->vs->ng[v->i], w)
-                        : cdl_bsdf_pdf(&v->b, cdl_normalize(cdl_sub(from, p)), w);
+    float sa = cdl_vertex_pdf_sa_bsdf(&g->cx, v->vs, v->i, &v->b, from, cdl_scale(w, 1.0f / len));
     return cdl_pdf_to_area(sa, p, to, nt);
 }
 
@@ -149,16 +136,15 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32
     cdl_vec3 w = cdl_scale(d, 1.0f / sqrtf(r2));
     int32_t ye = evs->parent[y];
     cdl_vec3 to_y = evs->p[ye];
-    cdl_vec3 fl = vertex_f(&par->xp, par->from, py, 1);
+    cdl_vec3 fl = vertex_f(g, &par->xp, par->from, py, 1);
     if (cdl_is_black(fl))
         return zero;
     cdl_gkde_vertex yv;
     vertex_init(g, evs, y, &yv);
-    cdl_vec3 fe = vertex_f(&yv, px, to_y, 0);
+    cdl_vec3 fe = vertex_f(g, &yv, px, to_y, 0);
     if (cdl_is_black(fe))
         return zero;
-    float p_sa = par->xp.light ? cdl_light_pdf_dir(par->xp.light, lvs->ng[xp], w)
-                               : cdl_bsdf_pdf(&par->xp.b, cdl_normalize(cdl_sub(par->from, px)), w);
+    float p_sa = cdl_vertex_pdf_sa_bsdf(&g->cx, lvs, xp, &par->xp.b, par->from, w);
     if (!(p_sa > 0.0f))
         return zero;
     float cos_x = cdl_is_black(par->nx) ? 1.0f : fabsf(cdl_dot(par->nx, w));
@@ -187,10 +173,10 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32
     /* densities through the new edge x_{k-1} -> y, both ways */
     pp.pl[k] = cdl_pdf_to_area(p_sa, px, py, evs->ng[y]);
     if (k + 1 < pp.n)
-        pp.pl[k + 1] = vertex_pdf(&yv, px, to_y, point_normal(evs, (uint32_t)ye));
-    pp.pe[k - 1] = vertex_pdf(&yv, to_y, px, point_normal(lvs, xp));
+        pp.pl[k + 1] = vertex_pdf(g, &yv, px, to_y, point_normal(evs, (uint32_t)ye));
+    pp.pe[k - 1] = vertex_pdf(g, &yv, to_y, px, point_normal(lvs, xp));
     if (k >= 2)
-        pp.pe[k - 2] = vertex_pdf(&par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
+        pp.pe[k - 2] = vertex_pdf(g, &par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
     return cdl_scale(c, weight(g, &pp, k));
 }
 
