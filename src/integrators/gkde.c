@@ -87,6 +87,7 @@ typedef struct gkde_state {
     uint32_t nrec;
     /* per point */
     uint32_t *count, *tested, *unocc;
+    uint16_t *pdepth; /* eye depth, in tree order (the candidate test reads it) */
     double *wsum, *scale, *cum;
     cdl_vec3 *acc;
     /* per pixel: tested and unoccluded links in earlier steps, by eye depth 1, 2, 3+ */
@@ -414,8 +415,10 @@ static int build_points(gkde_state *s, cdl_error *err)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");                \
         s->f = p_;                                                                                 \
     }
-    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc)
+    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc) GROW(pdepth)
 #undef GROW
+    for (uint32_t q = 0; q < n; q++)
+        s->pdepth[q] = s->evs.depth[point_vertex(s, q)];
     free(s->segs);
     /* about four parts per thread; results do not depend on the split */
     int depth = 1;
@@ -541,7 +544,7 @@ static void count_cb(void *ctx, uint32_t q, float d2)
     (void)d2;
     count_ctx *c = ctx;
     gkde_state *s = c->s;
-    if ((int)s->evs.depth[point_vertex(s, q)] > c->max_eye_depth || rec_push(c->r, q))
+    if ((int)s->pdepth[q] > c->max_eye_depth || rec_push(c->r, q))
         return;
     s->count[q]++;
     s->wsum[q] += c->a;
@@ -869,6 +872,7 @@ static void gkde_destroy(void *self)
         free(s->rec[i].v);
     free(s->rec);
     free(s->count);
+    free(s->pdepth);
     free(s->tested);
     free(s->unocc);
     free(s->wsum);
