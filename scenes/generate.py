@@ -3,7 +3,8 @@
 
     scenes/generate.py OUTDIR [NAME ...]
 
-writes NAME.obj, NAME.mtl and NAME.cam for every named scene (default: all) into
+writes NAME.obj, NAME.mtl and NAME.cam for every named scene (default: all but the
+large `building`, which is written only when named and is not committed) into
 OUTDIR. NAME.cam is one line of `--lookat ... --fov ...` arguments for a good
 default view, so that a script can run
 
@@ -775,6 +776,185 @@ def caustic_ring():
     return s
 
 
+def building():
+    """Bekaert et al. 2003, Fig. 6: a large building floor (120 x 60 m) of 276
+    furnished offices along five long corridors and three cross corridors, lit by
+    3672 small ceiling panels, most of them hidden from any one point."""
+    s = Scene("building")
+    P, NX, H, T = 4.0, 30, 3.0, 0.2   # office pitch along x, offices per row, height, walls
+    DO, DC = 5.0, 2.0                 # office and corridor depth along z (centre lines)
+    W = NX * P
+    CROSS = (7, 15, 22)               # slots of the cross corridors through the inner rows
+    white = s.material("wall_white", kd=(0.72, 0.71, 0.68))
+    corr_m = s.material("wall_corridor", kd=(0.55, 0.62, 0.58))
+    floor = s.material("floor", kd=(0.36, 0.35, 0.34))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood", kd=(0.50, 0.34, 0.20), ks=(0.04, 0.04, 0.04), ns=60)
+    door_m = s.material("wood_door", kd=(0.60, 0.45, 0.30))
+    metal = s.material("metal", kd=(0.25, 0.25, 0.27), ks=(0.30, 0.30, 0.30), ns=80)
+    black = s.material("screen", kd=(0.03, 0.03, 0.03), ks=(0.2, 0.2, 0.2), ns=200)
+    seats = [s.material("fabric_%s" % n, kd=c) for n, c in (
+        ("navy", (0.08, 0.12, 0.35)), ("red", (0.55, 0.08, 0.07)),
+        ("black", (0.06, 0.06, 0.07)), ("green", (0.12, 0.35, 0.15)))]
+    cols = [s.material("cabinet_%d" % i, kd=c) for i, c in enumerate(
+        [(0.6, 0.15, 0.1), (0.15, 0.45, 0.15), (0.7, 0.6, 0.2), (0.5, 0.5, 0.5)])]
+    books = [s.material("book_%d" % i, kd=c) for i, c in enumerate(
+        [(0.6, 0.1, 0.1), (0.1, 0.2, 0.5), (0.7, 0.6, 0.3), (0.15, 0.4, 0.15),
+         (0.75, 0.75, 0.7), (0.3, 0.15, 0.3)])]
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(12, 12, 12))
+    # bands along z from z = 0: an office row, then (corridor, office row, office row)
+    # four times, then a corridor and the last office row: 10 rows, 5 corridors
+    bands, z = [], 0.0
+    for kind in "OCOOCOOCOOCOOCO":
+        dz = DO if kind == "O" else DC
+        bands.append((kind, z, z + dz))
+        z += dz
+    D = z
+    corridors = [(z0, z1) for k, z0, z1 in bands if k == "C"]
+    rows = []   # (z0, z1, door wall z, corridor index, inner row?)
+    for i, (k, z0, z1) in enumerate(bands):
+        if k != "O":
+            continue
+        if i + 1 < len(bands) and bands[i + 1][0] == "C":
+            dz, c = z1, corridors.index(bands[i + 1][1:])
+        else:
+            dz, c = z0, corridors.index(bands[i - 1][1:])
+        rows.append((z0, z1, dz, c, 0 < i < len(bands) - 1))
+    y1 = H + 0.1
+    s.group("floor")
+    s.box((-T / 2, -T, -T / 2), (W + T / 2, 0, D + T / 2), floor)
+    s.group("ceiling")
+    s.box((-T / 2, H, -T / 2), (W + T / 2, H + T, D + T / 2), ceil)
+    s.group("outer_walls")
+    s.wall("x", 0, 0, W, T, white, y1=y1)
+    s.wall("x", D, 0, W, T, white, y1=y1)
+    s.wall("z", 0, 0, D, T, white, y1=y1)
+    s.wall("z", W, 0, D, T, white, y1=y1)
+
+    offices = []   # (x0, x1, z0, z1, door wall z, door (d0, d1), door near x0?, corridor)
+    for (z0, z1, dz, c, inner) in rows:
+        for k in range(NX):
+            if inner and k in CROSS:
+                continue
+            x0, x1 = k * P, (k + 1) * P
+            low = (k + c) % 2 == 0   # facing offices across a corridor share the door
+            d = (x0 + 0.6, x0 + 1.6) if low else (x1 - 1.6, x1 - 0.6)
+            offices.append((x0, x1, z0, z1, dz, d, low, c))
+    s.group("corridor_walls")   # with the office doors; the corridor side green-grey
+    for (x0, x1, z0, z1, dz, d, low, c) in offices:
+        side = "-z" if dz == z1 else "+z"   # the face towards the office
+        s.wall("x", dz, x0, x1, T, corr_m, doors=[d], y1=y1, face_mtl={side: white})
+    s.group("office_walls")
+    for (z0, z1, dz, c, inner) in rows:
+        back = z0 if dz == z1 else z1
+        for k in range(NX):
+            if inner and k not in CROSS:   # back-to-back rows: the wall between them
+                if back == z1:
+                    s.wall("x", back, k * P, (k + 1) * P, T, white, y1=y1)
+            if k > 0:                      # between neighbouring offices
+                s.wall("z", k * P, z0, z1, T, white, y1=y1)
+
+    s.group("lights")
+    ly = H - 0.01
+    for (x0, x1, z0, z1, dz, d, low, c) in offices:   # 3 x 4 panels of 0.3 x 0.3 m
+        for fx in (1 / 6, 3 / 6, 5 / 6):
+            for fz in (1 / 8, 3 / 8, 5 / 8, 7 / 8):
+                s.light(x0 + T / 2 + fx * (P - T), z0 + T / 2 + fz * (DO - T), 0.3, 0.3,
+                        ly, lamp)
+    for (z0, z1) in corridors:                        # one every 2 m along the corridors
+        for j in range(NX * 2):
+            s.light(1.0 + 2.0 * j, (z0 + z1) / 2, 0.3, 0.3, ly, lamp)
+    for k in CROSS:                                   # and along the cross corridors
+        for (ca, cb) in zip(corridors, corridors[1:]):
+            for j in range(5):
+                s.light((k + 0.5) * P, ca[1] + 1.0 + 2.0 * j, 0.3, 0.3, ly, lamp)
+
+    # the camera: in the office south of corridor 2 at slot 12, looking through its
+    # door and across the corridor into the office opposite
+    cam_slot, cam_c = 12, 2
+    rng = random.Random(2003)
+    s.group("furniture")
+    for (x0, x1, z0, z1, dz, d, low, c) in offices:
+        # local frame: u along the door wall from the side wall next to the door,
+        # v from the back wall towards the door wall; interior Wi x Di
+        Wi, Di = P - T, DO - T
+        back = z0 + T / 2 if dz == z1 else z1 - T / 2
+        sgn = 1 if dz == z1 else -1
+        xa = x0 + T / 2 if low else x1 - T / 2
+        su = 1 if low else -1
+
+        def X(u):
+            return xa + su * u
+
+        def Z(v):
+            return back + sgn * v
+
+        def lb(u0, v0, q0, u1, v1, q1, m):
+            xs, zs = sorted((X(u0), X(u1))), sorted((Z(v0), Z(v1)))
+            s.box((xs[0], q0, zs[0]), (xs[1], q1, zs[1]), m)
+
+        def facing(a):   # local facing (0: towards -v) -> world
+            if sgn < 0:
+                a = 180 - a
+            if su < 0:
+                a = -a
+            return a
+        # a desk against the back wall with a monitor and a chair facing the wall
+        ua = rng.uniform(0.3, 1.6)
+        u0, u1 = sorted((X(ua), X(ua + 1.6)))
+        v0, v1 = sorted((Z(0.02), Z(0.82)))
+        desk(s, u0, v0, 1.6, 0.8, wood, metal)
+        um = ua + rng.uniform(0.5, 1.1)
+        lb(um - 0.28, 0.15, 0.85, um + 0.28, 0.18, 1.2, black)
+        lb(um - 0.03, 0.15, 0.75, um + 0.03, 0.21, 0.85, metal)
+        lb(um - 0.12, 0.10, 0.75, um + 0.12, 0.27, 0.76, metal)
+        uc, vc = ua + 0.8 + rng.uniform(-0.3, 0.3), 1.25 + rng.uniform(-0.1, 0.2)
+        seat = seats[rng.randrange(len(seats))]
+        chair(s, X(uc), Z(vc), seat, metal, facing=facing(rng.uniform(-25, 25)))
+        # a bookshelf against the far side wall (u = Wi), open towards the room
+        sw, sd = rng.uniform(0.8, 1.0), 0.35
+        va = rng.uniform(1.1, 2.6)
+        sx0 = min(X(Wi - sd), X(Wi))
+        sz0 = min(Z(va), Z(va + sw))
+        shelf(s, sx0, sz0, sw, sd, rng.uniform(1.8, 2.2), wood, books,
+              boards=rng.choice((4, 5)), seed=rng.randrange(1 << 30), along="z",
+              flip=(su > 0))
+        # a cabinet against the side wall next to the door, clear of the open door
+        vk = rng.uniform(1.4, 2.2)
+        lb(0.01, vk, 0, 0.46, vk + 0.8, rng.uniform(0.9, 1.6), cols[rng.randrange(len(cols))])
+        # a small meeting table with a second chair in some offices
+        if rng.random() < 0.4:
+            ut, vt = rng.uniform(1.7, 2.2), rng.uniform(2.8, 3.2)
+            lb(ut, vt, 0.70, ut + 0.8, vt + 0.8, 0.74, wood)
+            lb(ut + 0.36, vt + 0.36, 0, ut + 0.44, vt + 0.44, 0.70, metal)
+            chair(s, X(ut + 0.4), Z(vt + 1.2), seats[rng.randrange(len(seats))], metal,
+                  facing=facing(rng.uniform(-20, 20)))
+        # the door leaf (0.04 m), hinged at the door's end near u = 0 on the wall's
+        # centre line; open into the office by 60-100 degrees, closed in one office
+        # in six (never on the camera's line of sight)
+        near_cam = c == cam_c and x0 == cam_slot * P
+        ang = 0.0 if (rng.random() < 1 / 6 and not near_cam) else rng.uniform(60, 100)
+        hx = d[0] if low else d[1]
+        dt = 0.04
+        # closed: u in [0.5 + 0.003, 1.5 - 0.003] around the hinge; world angle
+        # counter-clockwise seen from above turns +x into -z
+        a = ang * (1 if low else -1) * (1 if sgn > 0 else -1)
+        # check: the free end turns into the office (towards the back wall)
+        fz = dz - math.sin(math.radians(a)) * su
+        assert ang == 0 or (fz - dz) * (back - dz) > 0
+        xs = sorted((hx + su * 0.003, hx + su * 0.997))
+        s.box((xs[0], -0.02, dz - dt / 2), (xs[1], H_DOOR + 0.01, dz + dt / 2), door_m,
+              rot=(a, (hx, dz)) if ang else None)
+    # the camera stands near the back wall behind the door and looks through it and
+    # the opposite office's door (both at x0 + [0.6, 1.6] or x1 - [1.6, 0.6])
+    x0 = cam_slot * P
+    zc = [r for r in rows if r[3] == cam_c and r[2] == r[1]][0][1]   # the door wall z
+    su = 1 if (cam_slot + cam_c) % 2 == 0 else -1
+    xa = x0 if su > 0 else x0 + P
+    s.camera = ((xa + su * 1.5, 1.6, zc - DO + 0.5), (xa + su * 1.0, 1.1, zc + DC + 2.5), 65)
+    return s
+
+
 SCENES = {
     "office": office,
     "conference": conference,
@@ -785,23 +965,31 @@ SCENES = {
     "floor_many_lights": floor_many_lights,
     "caustic_ring": caustic_ring,
 }
+# Written only when named: too large to commit (about 300k triangles, 15 MB of OBJ),
+# so not part of the default "all scenes" and not in scenes/generated in git.
+ON_DEMAND = {
+    "building": building,
+}
 
 
 def main(argv):
+    known = dict(SCENES, **ON_DEMAND)
     if len(argv) < 2 or argv[1] in ("-h", "--help"):
-        sys.stderr.write("usage: %s OUTDIR [NAME ...]\nscenes: %s\n" % (
-            argv[0], " ".join(SCENES)))
+        sys.stderr.write("usage: %s OUTDIR [NAME ...]\n"
+                         "scenes (default: all of these): %s\n"
+                         "written only when named (large, not committed): %s\n" % (
+                             argv[0], " ".join(SCENES), " ".join(ON_DEMAND)))
         return 2
     outdir = argv[1]
     names = argv[2:] or list(SCENES)
     for n in names:
-        if n not in SCENES:
+        if n not in known:
             sys.stderr.write("%s: unknown scene '%s' (scenes: %s)\n" % (
-                argv[0], n, " ".join(SCENES)))
+                argv[0], n, " ".join(known)))
             return 2
     os.makedirs(outdir, exist_ok=True)
     for n in names:
-        s = SCENES[n]()
+        s = known[n]()
         s.write(outdir)
         print("%-18s %7d triangles, %4d light panels (%d emitting triangles), %.2f m^2 of light;"
               " camera: %s" % (n, s.triangles(), s.light_panels, s.emitting_triangles(),
