@@ -551,6 +551,7 @@ static void count_cb(void *ctx, uint32_t q, float d2)
 }
 
 typedef struct bundle {
+    cdl_gkde_link_state ls[MAX_BUNDLE];
     cdl_vec3 o[MAX_BUNDLE], d[MAX_BUNDLE], c[MAX_BUNDLE];
     float t[MAX_BUNDLE];
     uint32_t q[MAX_BUNDLE];
@@ -612,7 +613,7 @@ static void score_links(gkde_state *s, link_ctx *lc)
     cdl_gkde_parent_init(&s->g, xk, &par);
     for (uint32_t i = 0; i < lc->n; i++) {
         uint32_t q = lc->q[i], y = point_vertex(s, q);
-        cdl_vec3 c = cdl_gkde_link(&s->g, &par, y);
+        cdl_vec3 c = cdl_gkde_link(&s->g, &par, y, &b->ls[nb]);
         if (cdl_is_black(c))
             continue;
         cdl_vec3 d = cdl_sub(e->p[y], px);
@@ -634,15 +635,18 @@ static void score_links(gkde_state *s, link_ctx *lc)
     if (!nb)
         return;
     cdl_occluded_bundle(s->scene, nb, b->o, b->d, b->t, skip, b->blocked);
+    double t2 = cdl_time_now();
+    lc->t_rays += t2 - t1;
+    /* the strategy weights of the links that carry light */
     for (uint32_t i = 0; i < nb; i++) {
         uint32_t q = b->q[i];
         s->tested[q]++;
         if (!b->blocked[i]) {
             s->unocc[q]++;
-            s->acc[q] = cdl_add(s->acc[q], b->c[i]);
+            s->acc[q] = cdl_add(s->acc[q], cdl_scale(b->c[i], cdl_gkde_link_weight(&s->g, &par, &b->ls[i])));
         }
     }
-    lc->t_rays += cdl_time_now() - t1;
+    lc->t_score += cdl_time_now() - t2;
 }
 
 static uint32_t pv_bucket(const gkde_state *s, uint32_t y)

@@ -122,7 +122,7 @@ void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *p
     par->cos_k = cdl_maxf(fabsf(cdl_dot(lvs->ng[xk], lvs->wi[xk])), 1e-3f);
 }
 
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y)
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y, cdl_gkde_link_state *ls)
 {
     const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
     cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
@@ -139,9 +139,9 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32
     cdl_vec3 fl = vertex_f(g, &par->xp, par->from, py, 1);
     if (cdl_is_black(fl))
         return zero;
-    cdl_gkde_vertex yv;
-    vertex_init(g, evs, y, &yv);
-    cdl_vec3 fe = vertex_f(g, &yv, px, to_y, 0);
+    cdl_gkde_vertex *yv = &ls->yv;
+    vertex_init(g, evs, y, yv);
+    cdl_vec3 fe = vertex_f(g, yv, px, to_y, 0);
     if (cdl_is_black(fe))
         return zero;
     float p_sa = cdl_vertex_pdf_sa_bsdf(&g->cx, lvs, xp, &par->xp.b, par->from, w);
@@ -156,12 +156,22 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32
     c = cdl_scale(c, kern / (g->n_light * lvs->rr[xp]));
     if (cdl_is_black(c) || !cdl_is_finite3(c))
         return zero;
+    ls->p_sa = p_sa;
+    return c;
+}
 
+float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_link_state *ls)
+{
+    const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
+    const cdl_gkde_vertex *yv = &ls->yv;
+    uint32_t xp = par->xp.i, y = yv->i;
+    int32_t ye = evs->parent[y];
+    cdl_vec3 px = lvs->p[xp], py = evs->p[y], to_y = evs->p[ye];
     /* the path: x_0 .. x_{k-1}, then y_l .. y_1 */
     path_pdfs pp;
     int k = lvs->depth[xp] + 1;
     if (!fill_eye(evs, y, k, &pp))
-        return zero;
+        return 0.0f;
     int32_t v = (int32_t)xp, x0 = v;
     for (int i = k - 1; i >= 0; i--, v = lvs->parent[v]) {
         pp.pl[i] = lvs->pdf_fwd[v];
@@ -171,13 +181,13 @@ cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32
     }
     pp.s0 = !(lvs->flags[x0] & CDL_V_DELTA_LIGHT);
     /* densities through the new edge x_{k-1} -> y, both ways */
-    pp.pl[k] = cdl_pdf_to_area(p_sa, px, py, evs->ng[y]);
+    pp.pl[k] = cdl_pdf_to_area(ls->p_sa, px, py, evs->ng[y]);
     if (k + 1 < pp.n)
-        pp.pl[k + 1] = vertex_pdf(g, &yv, px, to_y, point_normal(evs, (uint32_t)ye));
-    pp.pe[k - 1] = vertex_pdf(g, &yv, to_y, px, point_normal(lvs, xp));
+        pp.pl[k + 1] = vertex_pdf(g, yv, px, to_y, point_normal(evs, (uint32_t)ye));
+    pp.pe[k - 1] = vertex_pdf(g, yv, to_y, px, point_normal(lvs, xp));
     if (k >= 2)
         pp.pe[k - 2] = vertex_pdf(g, &par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
-    return cdl_scale(c, weight(g, &pp, k));
+    return weight(g, &pp, k);
 }
 
 cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y)

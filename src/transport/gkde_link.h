@@ -83,12 +83,22 @@ typedef struct cdl_gkde_parent {
 
 void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *par);
 
+/* What the strategy weight of a link reuses from its score. */
+typedef struct cdl_gkde_link_state {
+    cdl_gkde_vertex yv;
+    float p_sa; /* x_{k-1} sampling the direction to y */
+} cdl_gkde_link_state;
+
 /* Score of the link (footprint of par->xk, eye vertex y) if the edge from
  * x_{k-1} to y is unoccluded: partial light score x partial eye score x
- * (8a) x (8b), times the strategy weight, per light path (the caller
+ * (8a) x (8b), per light path, before the strategy weight (the caller
  * divides by nothing more than the acceptance probability). Black when
- * the link cannot carry light (a BSDF or cosine is zero). */
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y);
+ * the link cannot carry light (a BSDF or cosine is zero); ls is filled
+ * otherwise. */
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y, cdl_gkde_link_state *ls);
+/* Its weight among every strategy that samples the same path (eq. 9
+ * generalized): computed only for links found unoccluded. */
+float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_link_state *ls);
 
 /* Emission an eye vertex y lying on an area light collects (the eye path
  * alone), times its weight against the merges of the same path. */
