@@ -62,8 +62,9 @@ static void render_help(void)
            "      --aov NAME          rigi: extra EXR layers: pathlength (average eye path\n"
            "                          length, Fig. 4) or strata (the contribution of each\n"
            "                          eye path length as layers strata1..strata8, Fig. 5)\n"
-           "      --shadow-rays KIND  rigi/ir: bundle (one Embree stream per point light and\n"
-           "                          tile, default) or single; pm: a number (below)\n"
+           "      --shadow-rays KIND  rigi/ir/gkde: bundle (one Embree ray stream per point\n"
+           "                          light and tile, or per footprint; default) or single;\n"
+           "                          pm: a number (below)\n"
            "  -q, --quiet             no warnings, no progress bar\n"
            "\n");
     cdl_pm_args_help();

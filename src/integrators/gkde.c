@@ -634,7 +634,11 @@ static void score_links(gkde_state *s, link_ctx *lc)
     lc->t_score += t1 - t0;
     if (!nb)
         return;
-    cdl_occluded_bundle(s->scene, nb, b->o, b->d, b->t, skip, b->blocked);
+    if (s->opt.single_shadow_rays) /* --shadow-rays single: for comparison */
+        for (uint32_t i = 0; i < nb; i++)
+            b->blocked[i] = (uint8_t)cdl_occluded_skip(s->scene, b->o[i], b->d[i], b->t[i], skip);
+    else
+        cdl_occluded_bundle(s->scene, nb, b->o, b->d, b->t, skip, b->blocked);
     double t2 = cdl_time_now();
     lc->t_rays += t2 - t1;
     /* the strategy weights of the links that carry light */
