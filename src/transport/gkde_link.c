@@ -82,8 +82,7 @@ static void vertex_init(const cdl_gkde_ctx *g, const cdl_vertex_store *vs, uint3
 {
     v->vs = vs;
     v->i = i;
-    v->light = (vs->flags[i] & CDL_V_LIGHT) ? &g->cx.scene->lights[vs->light[i]] : NULL;
-    if (!v->light)
+    if (!(vs->flags[i] & CDL_V_LIGHT)) /* a light-path start scatters by its emission */
         cdl_vs_bsdf(g->cx.scene, vs, i, &v->b);
 }
 

@@ -60,12 +60,11 @@ typedef struct cdl_gkde_ctx {
     float n_light;       /* light paths per step: the merge strategies' sample count */
 } cdl_gkde_ctx;
 
-/* A vertex with its scattering function built once: a light path's
- * start (the emission distribution) or a surface (the BSDF). */
+/* A vertex with its BSDF built once (a light path's start has none: it
+ * scatters by its emission distribution). */
 typedef struct cdl_gkde_vertex {
     const cdl_vertex_store *vs;
     uint32_t i;
-    const cdl_light *light; /* y_0 of a light path, else NULL */
     cdl_bsdf b;
 } cdl_gkde_vertex;
 
