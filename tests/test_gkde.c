@@ -76,7 +76,7 @@ static void radius(void)
 
 typedef struct hit_ctx {
     uint8_t *seen;
-    uint32_t dup;
+    uint32_t dup, ranges, in_ranges;
 } hit_ctx;
 
 static void mark(void *vc, uint32_t i, float d2)
@@ -87,70 +87,88 @@ static void mark(void *vc, uint32_t i, float d2)
     c->seen[i]++;
 }
 
-/* Leaf subtrees of [lo, hi) at `depth` levels plus the node points above
- * them, as gkde splits its eye points. */
-static void query_parts(const cdl_kdtree *t, uint32_t lo, uint32_t hi, int depth, cdl_vec3 q, float r2,
-                        hit_ctx *c, uint32_t *parts)
+static void mark_range(void *vc, uint32_t a, uint32_t b)
 {
-    if (lo >= hi)
-        return;
-    if (depth == 0 || hi - lo < 4) {
-        cdl_kd_ball_range(t, lo, hi, q, r2, mark, c);
-        (*parts)++;
-        return;
-    }
-    uint32_t mid = lo + (hi - lo) / 2;
-    cdl_kd_ball_range(t, mid, mid + 1, q, r2, mark, c);
-    query_parts(t, lo, mid, depth - 1, q, r2, c, parts);
-    query_parts(t, mid + 1, hi, depth - 1, q, r2, c, parts);
+    hit_ctx *c = vc;
+    for (uint32_t i = a; i < b; i++)
+        mark(vc, i, 0.0f);
+    c->ranges++;
+    c->in_ranges += b - a;
 }
 
-static void subtrees(void)
+/* cdl_kd_ball_cells over the parts of a tree in tree order (the two
+ * halves and the root point, each with the box of its points) against
+ * brute force; ranges must lie in the ball and carry most points of big
+ * balls. */
+static void cells(void)
 {
     cdl_rng r;
-    cdl_rng_seed(&r, 9, 2);
-    uint32_t n = 5000;
-    float *pts = malloc(sizeof(float) * 4 * n);
+    cdl_rng_seed(&r, 11, 3);
+    uint32_t n = 6000;
+    float *pts = malloc(sizeof(float) * 4 * n), *sorted = malloc(sizeof(float) * 4 * n);
     for (uint32_t i = 0; i < n; i++) {
         pts[4 * i] = cdl_rng_float(&r);
-        pts[4 * i + 1] = i % 2 ? 0.25f : cdl_rng_float(&r); /* half of them coplanar */
-        pts[4 * i + 2] = cdl_rng_float(&r);
+        pts[4 * i + 1] = i % 3 ? 0.5f : cdl_rng_float(&r); /* most on a plane */
+        pts[4 * i + 2] = i % 5 ? cdl_rng_float(&r) : 0.125f;
         pts[4 * i + 3] = 0.0f;
     }
     cdl_kdtree t;
     cdl_error err;
     die_on(cdl_kd_build(&t, pts, 4, n, &err), &err);
+    for (uint32_t q = 0; q < n; q++)
+        memcpy(&sorted[4 * q], &pts[4 * t.idx[q]], 4 * sizeof(float));
+    t.pts = sorted;
+    cdl_kd_make_identity(&t);
+    uint32_t mid = n / 2, part[3][2] = {{0, mid}, {mid, mid + 1}, {mid + 1, n}};
+    float lo[3][3], hi[3][3];
+    for (int p = 0; p < 3; p++)
+        for (int a = 0; a < 3; a++) {
+            lo[p][a] = INFINITY;
+            hi[p][a] = -INFINITY;
+            for (uint32_t i = part[p][0]; i < part[p][1]; i++) {
+                lo[p][a] = fminf(lo[p][a], sorted[4 * i + a]);
+                hi[p][a] = fmaxf(hi[p][a], sorted[4 * i + a]);
+            }
+        }
     uint8_t *seen = calloc(n, 1);
-    uint32_t wrong = 0, dups = 0, found = 0;
-    for (int k = 0; k < 300; k++) {
-        cdl_vec3 q = cdl_v3(cdl_rng_float(&r), k % 2 ? 0.25f : cdl_rng_float(&r), cdl_rng_float(&r));
-        float rad = 0.3f * cdl_rng_float(&r), r2 = rad * rad;
+    uint32_t wrong = 0, dups = 0, found = 0, outside = 0, ranges = 0, in_ranges = 0, counted = 0;
+    for (int k = 0; k < 400; k++) {
+        cdl_vec3 q = cdl_v3(cdl_rng_float(&r), k % 2 ? 0.5f : cdl_rng_float(&r), cdl_rng_float(&r));
+        float rad = (k % 4 ? 0.4f : 0.05f) * cdl_rng_float(&r), r2 = rad * rad;
         memset(seen, 0, n);
-        hit_ctx c = {seen, 0};
-        uint32_t parts = 0;
-        query_parts(&t, 0, n, 1 + k % 6, q, r2, &c, &parts);
+        hit_ctx c = {seen, 0, 0, 0};
+        for (int p = 0; p < 3; p++)
+            counted += cdl_kd_ball_cells(&t, part[p][0], part[p][1], lo[p], hi[p], q, r2, mark, mark_range, &c);
+        ranges += c.ranges;
+        in_ranges += c.in_ranges;
         dups += c.dup;
         for (uint32_t i = 0; i < n; i++) {
-            float dx = pts[4 * i] - q.x, dy = pts[4 * i + 1] - q.y, dz = pts[4 * i + 2] - q.z;
+            float dx = sorted[4 * i] - q.x, dy = sorted[4 * i + 1] - q.y, dz = sorted[4 * i + 2] - q.z;
             int in = dx * dx + dy * dy + dz * dz <= r2;
             wrong += (uint32_t)(in != (seen[i] > 0));
             found += (uint32_t)in;
+            outside += (uint32_t)(!in && seen[i]);
         }
     }
-    CHECK(wrong == 0 && dups == 0 && found > 1000,
-          "ball queries over kd subtrees and node points = brute force (%u points found, %u wrong, %u twice)",
-          found, wrong, dups);
-    CHECK(cdl_kd_ball_range(&t, 0, n + 1, cdl_v3(0.5f, 0.5f, 0.5f), 1.0f, mark, &(hit_ctx){seen, 0}) == 0,
+    CHECK(wrong == 0 && dups == 0 && outside == 0 && counted == found && found > 100000,
+          "cell ball queries = brute force (%u points found, %u wrong, %u twice, %u outside, %u counted)", found,
+          wrong, dups, outside, counted);
+    CHECK(in_ranges * 2 > found && ranges * 8 < in_ranges,
+          "big balls report whole cells (%u of %u points in %u ranges)", in_ranges, found, ranges);
+    float blo[3] = {0, 0, 0}, bhi[3] = {1, 1, 1};
+    CHECK(cdl_kd_ball_cells(&t, 0, n + 1, blo, bhi, cdl_v3(0.5f, 0.5f, 0.5f), 1.0f, mark, mark_range,
+                            &(hit_ctx){seen, 0, 0, 0}) == 0,
           "a range beyond the tree finds nothing");
     cdl_kd_free(&t);
     free(seen);
     free(pts);
+    free(sorted);
 }
 
 int main(void)
 {
     sampler();
     radius();
-    subtrees();
+    cells();
     return test_failures ? 1 : 0;
 }

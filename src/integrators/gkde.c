@@ -94,7 +94,7 @@ static size_t stored_bytes(const gkde_state *s)
     return s->rec_bytes + cdl_vs_bytes(&s->lvs) + cdl_vs_bytes(&s->evs) + (size_t)s->evs.cap * sizeof *s->epix +
            (size_t)s->lvs.cap * (sizeof *s->radius + sizeof *s->lv) +
            (size_t)s->npts * (4 * sizeof(float) + 5 + 3 * sizeof(uint32_t) + 3 * sizeof(double) +
-                              sizeof(cdl_vec3));
+                              sizeof(cdl_vec3) + sizeof(cdl_gkde_eye));
 }
 
 static int check_memory(gkde_state *s, cdl_error *err)
@@ -214,6 +214,57 @@ static int trace_lights(gkde_state *s, uint32_t pass, uint64_t *rays, cdl_error 
 /* Footprint radii (eq. 7) for bandwidth h, and the light vertices that
  * can link: x_k past the start whose parent is not specular, with a
  * bounce left for the eye path. */
+/* 10 bits of x spread to every third bit. */
+static uint64_t spread3(uint32_t x)
+{
+    uint64_t v = x & 0x3ff;
+    v = (v | v << 16) & 0x30000ff;
+    v = (v | v << 8) & 0x300f00f;
+    v = (v | v << 4) & 0x30c30c3;
+    return (v | v << 2) & 0x9249249;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The footprints in Morton order of their centres: consecutive footprints
+ * meet the same eye points, so stages 3-5 find them in cache (the fixed
+ * order the stratified draws follow; any fixed order is as good). */
+static int sort_spatially(gkde_state *s, cdl_error *err)
+{
+    const cdl_vertex_store *l = &s->lvs;
+    uint32_t n = s->nlv;
+    uint64_t *key = malloc(sizeof *key * (n ? n : 1));
+    if (!key)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t a = 0; a < n; a++) {
+        const float *p = &l->p[s->lv[a]].x;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = p[k] < lo[k] ? p[k] : lo[k];
+            hi[k] = p[k] > hi[k] ? p[k] : hi[k];
+        }
+    }
+    float ext = cdl_maxf(hi[0] - lo[0], cdl_maxf(hi[1] - lo[1], hi[2] - lo[2]));
+    float sc = ext > 0.0f ? 1023.0f / ext : 0.0f;
+#pragma omp parallel for schedule(static)
+    for (uint32_t a = 0; a < n; a++) {
+        const float *p = &l->p[s->lv[a]].x;
+        uint64_t m = 0;
+        for (int k = 0; k < 3; k++)
+            m |= spread3((uint32_t)((p[k] - lo[k]) * sc)) << k;
+        key[a] = m << 32 | s->lv[a];
+    }
+    qsort(key, n, sizeof *key, cmp_u64);
+    for (uint32_t a = 0; a < n; a++)
+        s->lv[a] = (uint32_t)key[a];
+    free(key);
+    return 0;
+}
+
 static int footprints(gkde_state *s, float h, cdl_error *err)
 {
     const cdl_vertex_store *l = &s->lvs;
@@ -233,7 +284,7 @@ static int footprints(gkde_state *s, float h, cdl_error *err)
             isfinite(r[i]))
             lv[s->nlv++] = i;
     }
-    return 0;
+    return sort_spatially(s, err);
 }
 
 
@@ -317,6 +368,8 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     double t2 = cdl_time_now();
     s->st.t_eye += t1 - t0;
     s->st.t_light += t2 - t1;
+    s->g.lvs = &s->lvs;
+    s->g.evs = &s->evs;
     if (!rc)
         rc = gkde_build_points(s, err);
     if (!rc)
@@ -334,8 +387,6 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     rc = footprints(s, s->h, err);
     if (rc)
         return rc;
-    s->g.lvs = &s->lvs;
-    s->g.evs = &s->evs;
     s->g.radius = s->radius;
     s->st.t_count += cdl_time_now() - t2;
     uint64_t lr = gkde_link_all(s, pass);
@@ -423,6 +474,7 @@ static void gkde_destroy(void *self)
     free(s->scale);
     free(s->cum);
     free(s->acc);
+    free(s->eye);
     free(s->pv);
     free(s->pixsum);
 }

@@ -63,6 +63,7 @@ typedef struct gkde_state {
     uint16_t *pdepth; /* eye depth, in tree order (the candidate test reads it) */
     double *wsum, *scale, *cum;
     cdl_vec3 *acc;
+    cdl_gkde_eye *eye; /* what links read of each point's eye vertex */
     /* per pixel: tested and unoccluded links in earlier steps, by eye depth 1, 2, 3+ */
     uint32_t *pv;
     cdl_vec3 *pixsum;

@@ -13,6 +13,7 @@
 #include "integrators/gkde.h"
 
 #define MAX_BUNDLE 4096 /* links per footprint and subtree traced at once */
+#define RANGE 0x80000000u /* a candidate record entry starting a range of points */
 
 static void grow_box(seg *g, const float *p)
 {
@@ -56,10 +57,12 @@ static void make_segs(gkde_state *s, uint32_t lo, uint32_t hi, int depth, const 
     make_segs(s, mid + 1, hi, depth - 1, &mid, 1);
 }
 
-/* The points of g within distance sqrt(r2) of c, subtree first. */
-static void seg_ball(const gkde_state *s, const seg *g, cdl_vec3 c, float r2, cdl_kd_visit fn, void *ctx)
+/* The points of g within distance sqrt(r2) of c, subtree first; whole
+ * cells inside the ball come as ranges. */
+static void seg_ball(const gkde_state *s, const seg *g, cdl_vec3 c, float r2, cdl_kd_visit fn,
+                     cdl_kd_visit_range fr, void *ctx)
 {
-    cdl_kd_ball_range(&s->kd, g->lo, g->hi, c, r2, fn, ctx);
+    cdl_kd_ball_cells(&s->kd, g->lo, g->hi, g->bmin, g->bmax, c, r2, fn, fr, ctx);
     for (uint32_t i = 0; i < g->nextra; i++) {
         const float *p = &s->pts[4 * (size_t)g->extra[i]];
         float dx = p[0] - c.x, dy = p[1] - c.y, dz = p[2] - c.z, d2 = dx * dx + dy * dy + dz * dz;
@@ -86,6 +89,8 @@ int gkde_build_points(gkde_state *s, cdl_error *err)
     uint32_t n = 0;
     for (uint32_t i = 0; i < e->n; i++)
         n += !(e->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA)) && e->depth[i] <= s->opt.maxdepth;
+    if (n >= RANGE)
+        return cdl_error_set(err, CDL_ERR_USAGE, "gkde", 0, "%u eye vertices: more than 2^31 per step", n);
     float *pts = malloc(sizeof(float) * 4 * (n ? n : 1));
     if (!pts)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
@@ -126,10 +131,14 @@ int gkde_build_points(gkde_state *s, cdl_error *err)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");                \
         s->f = p_;                                                                                 \
     }
-    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc) GROW(pdepth)
+    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc) GROW(pdepth) GROW(eye)
 #undef GROW
-    for (uint32_t q = 0; q < n; q++)
-        s->pdepth[q] = s->evs.depth[gkde_point_vertex(s, q)];
+#pragma omp parallel for schedule(static)
+    for (uint32_t q = 0; q < n; q++) {
+        uint32_t y = gkde_point_vertex(s, q);
+        s->pdepth[q] = s->evs.depth[y];
+        cdl_gkde_eye_init(&s->g, y, &s->eye[q]);
+    }
     free(s->segs);
     /* about four parts per thread; results do not depend on the split */
     int depth = 1;
@@ -193,6 +202,28 @@ static void count_cb(void *ctx, uint32_t q, float d2)
     s->wsum[q] += c->a;
 }
 
+/* A range of points inside the footprint: one record entry (RANGE | a, b)
+ * when every point in it may be linked. */
+static void count_range(void *ctx, uint32_t a, uint32_t b)
+{
+    count_ctx *c = ctx;
+    gkde_state *s = c->s;
+    uint32_t ok = 1;
+    for (uint32_t q = a; q < b; q++)
+        ok &= (int)s->pdepth[q] <= c->max_eye_depth;
+    if (!ok || b - a < 3) {
+        for (uint32_t q = a; q < b; q++)
+            count_cb(ctx, q, 0.0f);
+        return;
+    }
+    if (rec_push(c->r, RANGE | a) || rec_push(c->r, b))
+        return;
+    for (uint32_t q = a; q < b; q++) {
+        s->count[q]++;
+        s->wsum[q] += c->a;
+    }
+}
+
 typedef struct bundle {
     cdl_gkde_link_state ls[MAX_BUNDLE];
     cdl_vec3 o[MAX_BUNDLE], d[MAX_BUNDLE], c[MAX_BUNDLE];
@@ -237,9 +268,22 @@ static void link_point(link_ctx *c, uint32_t q)
     c->trials++;
 }
 
+#define PREFETCH 8 /* links ahead: a record is a few cache lines anywhere in the part */
+
+static void prefetch_eye(const gkde_state *s, uint32_t q)
+{
+#if defined(__GNUC__)
+    const char *p = (const char *)&s->eye[q];
+    for (size_t o = 0; o < sizeof(cdl_gkde_eye); o += 64)
+        __builtin_prefetch(p + o);
+#else
+    (void)s, (void)q;
+#endif
+}
+
 static void score_links(gkde_state *s, link_ctx *lc)
 {
-    const cdl_vertex_store *l = &s->lvs, *e = &s->evs;
+    const cdl_vertex_store *l = &s->lvs;
     uint32_t xk = lc->xk;
     bundle *b = lc->b;
     double t0 = cdl_time_now();
@@ -254,14 +298,19 @@ static void score_links(gkde_state *s, link_ctx *lc)
     }
     cdl_gkde_parent par;
     cdl_gkde_parent_init(&s->g, xk, &par);
+    for (uint32_t i = 0; i < lc->n && i < PREFETCH; i++)
+        prefetch_eye(s, lc->q[i]);
     for (uint32_t i = 0; i < lc->n; i++) {
-        uint32_t q = lc->q[i], y = gkde_point_vertex(s, q);
-        cdl_vec3 c = cdl_gkde_link(&s->g, &par, y, &b->ls[nb]);
+        uint32_t q = lc->q[i];
+        if (i + PREFETCH < lc->n)
+            prefetch_eye(s, lc->q[i + PREFETCH]);
+        const cdl_gkde_eye *ye = &s->eye[q];
+        cdl_vec3 c = cdl_gkde_link(&s->g, &par, ye, &b->ls[nb]);
         if (cdl_is_black(c))
             continue;
-        cdl_vec3 d = cdl_sub(e->p[y], px);
+        cdl_vec3 d = cdl_sub(ye->p, px);
         cdl_vec3 o = point ? px : cdl_offset(s->scene, px, l->ng[xp], d);
-        cdl_vec3 end = cdl_offset(s->scene, e->p[y], e->ng[y], cdl_neg(d));
+        cdl_vec3 end = cdl_offset(s->scene, ye->p, ye->b.ng, cdl_neg(d));
         cdl_vec3 de = cdl_sub(end, o);
         float len = cdl_length(de);
         if (!(len > 0.0f))
@@ -328,7 +377,7 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
             size_t at = r->n;
             if (rec_push(r, a) || rec_push(r, 0))
                 break;
-            seg_ball(s, sg, s->lvs.p[xk], R * R, count_cb, &c);
+            seg_ball(s, sg, s->lvs.p[xk], R * R, count_cb, count_range, &c);
             if (r->n == at + 2)
                 r->n = at; /* none */
             else
@@ -383,8 +432,15 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
                 lc->a = accept_weight(s, xk);
                 lc->n = 0;
                 lc->xk = xk;
-                for (uint32_t j = 0; j < c; j++)
-                    link_point(lc, qs[j]);
+                for (uint32_t j = 0; j < c; j++) {
+                    if (!(qs[j] & RANGE)) {
+                        link_point(lc, qs[j]);
+                        continue;
+                    }
+                    for (uint32_t q = qs[j] & ~RANGE; q < qs[j + 1]; q++)
+                        link_point(lc, q);
+                    j++;
+                }
                 if (lc->n)
                     score_links(s, lc);
             }

@@ -250,8 +250,68 @@ uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn,
     return t->n ? ball_search(t, 0, t->n, q, r2, fn, ctx) : 0;
 }
 
-uint32_t cdl_kd_ball_range(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2,
-                           cdl_kd_visit fn, void *ctx)
+typedef struct cell_query {
+    const cdl_kdtree *t;
+    float q[3], r2;
+    cdl_kd_visit fn;
+    cdl_kd_visit_range fr;
+    void *ctx;
+    uint32_t count;
+} cell_query;
+
+#define CELL_LEAF 8 /* ranges this small are tested point by point */
+
+static void cells(cell_query *c, uint32_t lo, uint32_t hi, const float *box_min, const float *box_max)
 {
-    return lo < hi && hi <= t->n ? ball_search(t, lo, hi, q, r2, fn, ctx) : 0;
+    const cdl_kdtree *t = c->t;
+    float bmin[3] = {box_min[0], box_min[1], box_min[2]}, bmax[3] = {box_max[0], box_max[1], box_max[2]};
+    while (lo < hi) {
+        float near = 0.0f, far = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            float dl = c->q[a] - bmin[a], dh = bmax[a] - c->q[a];
+            float out = dl < 0.0f ? -dl : dh < 0.0f ? -dh : 0.0f, f = dl > dh ? dl : dh;
+            near += out * out;
+            far += f * f;
+        }
+        if (near > c->r2)
+            return;
+        if (far <= c->r2) {
+            c->fr(c->ctx, lo, hi);
+            c->count += hi - lo;
+            return;
+        }
+        if (hi - lo <= CELL_LEAF) {
+            for (uint32_t i = lo; i < hi; i++) {
+                float d = dist2(t, i, (cdl_vec3){c->q[0], c->q[1], c->q[2]});
+                if (d <= c->r2) {
+                    c->fn(c->ctx, i, d);
+                    c->count++;
+                }
+            }
+            return;
+        }
+        uint32_t mid = lo + (hi - lo) / 2;
+        int a = t->axis[mid];
+        float s = coord(t, mid, a), d = dist2(t, mid, (cdl_vec3){c->q[0], c->q[1], c->q[2]});
+        float lmax[3] = {bmax[0], bmax[1], bmax[2]};
+        lmax[a] = s;
+        cells(c, lo, mid, bmin, lmax); /* recursion depth is log2(n) */
+        if (d <= c->r2) {
+            c->fn(c->ctx, mid, d);
+            c->count++;
+        }
+        bmin[a] = s;
+        lo = mid + 1;
+    }
+}
+
+uint32_t cdl_kd_ball_cells(const cdl_kdtree *t, uint32_t lo, uint32_t hi, const float bmin[3],
+                           const float bmax[3], cdl_vec3 q, float r2, cdl_kd_visit fn, cdl_kd_visit_range fr,
+                           void *ctx)
+{
+    if (!(lo < hi && hi <= t->n) || !t->identity)
+        return 0;
+    cell_query c = {t, {q.x, q.y, q.z}, r2, fn, fr, ctx, 0};
+    cells(&c, lo, hi, bmin, bmax);
+    return c.count;
 }

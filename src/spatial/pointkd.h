@@ -44,13 +44,19 @@ void cdl_kd_make_identity(cdl_kdtree *t);
 typedef void (*cdl_kd_visit)(void *ctx, uint32_t point, float d2);
 uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn, void *ctx);
 
-/* The same within one subtree: the points at tree positions [lo, hi), a
- * range of the form [0, n) and, recursively, [lo, mid) and [mid + 1, hi)
- * around mid = lo + (hi - lo) / 2 (a single position [mid, mid + 1) is
- * one too). Such ranges split the points into disjoint parts that
- * threads can own, each visiting its points in a fixed order. */
-uint32_t cdl_kd_ball_range(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2,
-                           cdl_kd_visit fn, void *ctx);
+/* A ball query that reports whole subtrees inside the ball at once: for
+ * a tree in tree order (cdl_kd_make_identity), over the positions [lo, hi)
+ * of a subtree (a range of the form [0, n) and, recursively, [lo, mid) and
+ * [mid + 1, hi) around mid = lo + (hi - lo) / 2, or a single position
+ * [mid, mid + 1): disjoint parts threads can own), whose points lie in the box
+ * [bmin, bmax]. Every point within sqrt(r2) of q is reported once, either
+ * alone through fn or inside a range [a, b) through fr whose points all
+ * lie in the ball (a subtree whose bounding cell does). Big balls cost
+ * a few cell tests instead of a test per point. Returns the count. */
+typedef void (*cdl_kd_visit_range)(void *ctx, uint32_t a, uint32_t b);
+uint32_t cdl_kd_ball_cells(const cdl_kdtree *t, uint32_t lo, uint32_t hi, const float bmin[3],
+                           const float bmax[3], cdl_vec3 q, float r2, cdl_kd_visit fn, cdl_kd_visit_range fr,
+                           void *ctx);
 
 /* Bytes held by the tree (not the points). */
 static inline size_t cdl_kd_bytes(const cdl_kdtree *t) { return (size_t)t->n * 5u; }

@@ -27,7 +27,7 @@ static float log1(float p) { return p > 0.0f ? logf(p) : 0.0f; } /* Dirac or unk
  * eq. 7 around z_j, found by one of N light paths) and d_0 = prod pe_i. It
  * is eq. 9 for two strategies; a partition of unity for any path, so the
  * strategies' sum stays consistent. */
-static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
+static float weight_log(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
 {
     int n = pp->n;
     double lsum_pe[MAX_PATH + 1];
@@ -60,6 +60,33 @@ static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
     return (float)(exp(ld[cur] - best) / sum);
 }
 
+static double nz(float p) { return p > 0.0f ? (double)p : 1.0; } /* as log1: a Dirac density cancels */
+
+/* The same weight by the ratios d_j / d_0 in double (no logarithms: the
+ * cost of most links' weight); the logarithms when a ratio overflows. */
+static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
+{
+    int n = pp->n;
+    double npi = (double)g->n_light * CDL_PI, b = 1.0, sum = pp->s0 ? 1.0 : 0.0;
+    double dcur = cur == 0 ? sum : 0.0;
+    float r = 0.0f;
+    for (int j = 1; j < n; j++) {
+        b *= j == 1 ? nz(pp->pl[0]) * nz(pp->pl[1]) / nz(pp->pe[0]) : nz(pp->pl[j]) / nz(pp->pe[j - 1]);
+        r = cdl_footprint_radius(g->h, pp->pl[j], r, g->r_cap);
+        if (pp->delta[j] || pp->delta[j - 1] || !(r > 0.0f))
+            continue;
+        double d = b * npi * (double)r * (double)r;
+        sum += d;
+        if (j == cur)
+            dcur = d;
+    }
+    if (!(dcur > 0.0))
+        return 0.0f;
+    if (!(sum < INFINITY))
+        return weight_log(g, pp, cur);
+    return (float)(dcur / sum);
+}
+
 /* The eye vertices of y's path from y (depth l) down to y_1 fill z_k ..
  * z_{k+l-1}; light-side densities from z_{k+2} on are the stored reverse
  * ones (the caller sets z_k and z_{k+1}). Returns 0 if too long. */
@@ -74,6 +101,23 @@ static int fill_eye(const cdl_vertex_store *evs, uint32_t y, int k, path_pdfs *p
         pp->pe[i] = evs->pdf_fwd[v];
         pp->pl[i] = evs->pdf_rev[v];
         pp->delta[i] = (evs->flags[v] & CDL_V_DELTA) != 0;
+    }
+    return 1;
+}
+
+/* fill_eye from y's record when it holds the whole eye path. */
+static int fill_eye_rec(const cdl_gkde_ctx *g, const cdl_gkde_eye *ye, int k, path_pdfs *pp)
+{
+    int l = ye->depth;
+    if (l > CDL_GKDE_EYE_INLINE)
+        return fill_eye(g->evs, ye->y, k, pp);
+    if (k + l > MAX_PATH)
+        return 0;
+    pp->n = k + l;
+    for (int i = 0; i < l; i++) {
+        pp->pe[k + i] = ye->pe[i];
+        pp->pl[k + i] = ye->pl[i];
+        pp->delta[k + i] = (uint8_t)(ye->delta >> i & 1);
     }
     return 1;
 }
@@ -121,55 +165,84 @@ void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *p
     par->cos_k = cdl_maxf(fabsf(cdl_dot(lvs->ng[xk], lvs->wi[xk])), 1e-3f);
 }
 
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y, cdl_gkde_link_state *ls)
+void cdl_gkde_eye_init(const cdl_gkde_ctx *g, uint32_t y, cdl_gkde_eye *e)
 {
-    const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
+    const cdl_vertex_store *evs = g->evs;
+    cdl_vs_bsdf(g->cx.scene, evs, y, &e->b);
+    uint32_t ye = (uint32_t)evs->parent[y];
+    e->p = evs->p[y];
+    e->ns = evs->ns[y];
+    e->beta = evs->beta[y];
+    e->to = evs->p[ye];
+    e->to_n = point_normal(evs, ye);
+    e->y = y;
+    e->depth = evs->depth[y];
+    e->delta = 0;
+    int32_t v = (int32_t)y;
+    for (int i = 0; i < e->depth && i < CDL_GKDE_EYE_INLINE; i++, v = evs->parent[v]) {
+        e->pe[i] = evs->pdf_fwd[v];
+        e->pl[i] = evs->pdf_rev[v];
+        e->delta |= (uint8_t)(((evs->flags[v] & CDL_V_DELTA) != 0) << i);
+    }
+}
+
+/* Area density at `to` (normal nt) of y sampling it, light arriving from `from`. */
+static float eye_pdf(const cdl_gkde_eye *e, cdl_vec3 from, cdl_vec3 to, cdl_vec3 nt)
+{
+    cdl_vec3 w = cdl_sub(to, e->p);
+    float len = cdl_length(w);
+    if (!(len > 0.0f))
+        return 0.0f;
+    float sa = cdl_bsdf_pdf(&e->b, cdl_normalize(cdl_sub(from, e->p)), cdl_scale(w, 1.0f / len));
+    return cdl_pdf_to_area(sa, e->p, to, nt);
+}
+
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_eye *ye,
+                       cdl_gkde_link_state *ls)
+{
+    const cdl_vertex_store *lvs = g->lvs;
     cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
-    if (!par->ok || (evs->flags[y] & (CDL_V_DELTA | CDL_V_CAMERA)))
+    if (!par->ok)
         return zero;
     uint32_t xp = par->xp.i;
-    cdl_vec3 px = lvs->p[xp], py = evs->p[y], d = cdl_sub(py, px);
+    cdl_vec3 px = lvs->p[xp], py = ye->p, d = cdl_sub(py, px);
     float r2 = cdl_dot(d, d);
     if (!(r2 > 0.0f))
         return zero;
     cdl_vec3 w = cdl_scale(d, 1.0f / sqrtf(r2));
-    int32_t ye = evs->parent[y];
-    cdl_vec3 to_y = evs->p[ye];
     cdl_vec3 fl = vertex_f(g, &par->xp, par->from, py, 1);
     if (cdl_is_black(fl))
         return zero;
-    cdl_gkde_vertex *yv = &ls->yv;
-    vertex_init(g, evs, y, yv);
-    cdl_vec3 fe = vertex_f(g, yv, px, to_y, 0);
+    cdl_vec3 fe = cdl_bsdf_eval(&ye->b, cdl_neg(w), cdl_normalize(cdl_sub(ye->to, py)), 0);
     if (cdl_is_black(fe))
         return zero;
     float p_sa = cdl_vertex_pdf_sa_bsdf(&g->cx, lvs, xp, &par->xp.b, par->from, w);
     if (!(p_sa > 0.0f))
         return zero;
     float cos_x = cdl_is_black(par->nx) ? 1.0f : fabsf(cdl_dot(par->nx, w));
-    float cos_y = fabsf(cdl_dot(evs->ns[y], w));
+    float cos_y = fabsf(cdl_dot(ye->ns, w));
     float R = g->radius[par->xk];
     float kern = cos_x * cos_y / (CDL_PI * R * R * par->cos_k * p_sa);
-    cdl_vec3 c = cdl_mul(cdl_mul(lvs->beta[xp], fl), cdl_mul(fe, evs->beta[y]));
+    cdl_vec3 c = cdl_mul(cdl_mul(lvs->beta[xp], fl), cdl_mul(fe, ye->beta));
     /* x_k exists only if the light path survived Russian roulette at x_{k-1} */
     c = cdl_scale(c, kern / (g->n_light * lvs->rr[xp]));
     if (cdl_is_black(c) || !cdl_is_finite3(c))
         return zero;
+    ls->ye = ye;
     ls->p_sa = p_sa;
     return c;
 }
 
 float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_link_state *ls)
 {
-    const cdl_vertex_store *lvs = g->lvs, *evs = g->evs;
-    const cdl_gkde_vertex *yv = &ls->yv;
-    uint32_t xp = par->xp.i, y = yv->i;
-    int32_t ye = evs->parent[y];
-    cdl_vec3 px = lvs->p[xp], py = evs->p[y], to_y = evs->p[ye];
+    const cdl_vertex_store *lvs = g->lvs;
+    const cdl_gkde_eye *ye = ls->ye;
+    uint32_t xp = par->xp.i;
+    cdl_vec3 px = lvs->p[xp], py = ye->p;
     /* the path: x_0 .. x_{k-1}, then y_l .. y_1 */
     path_pdfs pp;
     int k = lvs->depth[xp] + 1;
-    if (!fill_eye(evs, y, k, &pp))
+    if (!fill_eye_rec(g, ye, k, &pp))
         return 0.0f;
     int32_t v = (int32_t)xp, x0 = v;
     for (int i = k - 1; i >= 0; i--, v = lvs->parent[v]) {
@@ -180,10 +253,10 @@ float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, co
     }
     pp.s0 = !(lvs->flags[x0] & CDL_V_DELTA_LIGHT);
     /* densities through the new edge x_{k-1} -> y, both ways */
-    pp.pl[k] = cdl_pdf_to_area(ls->p_sa, px, py, evs->ng[y]);
+    pp.pl[k] = cdl_pdf_to_area(ls->p_sa, px, py, ye->b.ng);
     if (k + 1 < pp.n)
-        pp.pl[k + 1] = vertex_pdf(g, yv, px, to_y, point_normal(evs, (uint32_t)ye));
-    pp.pe[k - 1] = vertex_pdf(g, yv, to_y, px, point_normal(lvs, xp));
+        pp.pl[k + 1] = eye_pdf(ye, px, ye->to, ye->to_n);
+    pp.pe[k - 1] = eye_pdf(ye, ye->to, px, point_normal(lvs, xp));
     if (k >= 2)
         pp.pe[k - 2] = vertex_pdf(g, &par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
     return weight(g, &pp, k);

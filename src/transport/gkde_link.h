@@ -82,9 +82,28 @@ typedef struct cdl_gkde_parent {
 
 void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *par);
 
+/* An eye vertex y as links read it, built once per step: every link to y
+ * reads one record (in the eye points' tree order, so the candidates of a
+ * footprint sit together) instead of the scattered store, and y's BSDF is
+ * built once, not once per link. */
+#define CDL_GKDE_EYE_INLINE 4
+typedef struct cdl_gkde_eye {
+    cdl_bsdf b;
+    cdl_vec3 p, ns, beta;
+    cdl_vec3 to, to_n; /* y's predecessor towards the camera: position, normal (zero: a point) */
+    uint32_t y;        /* index in the eye store */
+    uint16_t depth;
+    uint8_t delta;     /* bit i: the i-th vertex from y towards the camera is specular */
+    /* the densities of the eye path from y on (the store holds longer ones) */
+    float pe[CDL_GKDE_EYE_INLINE], pl[CDL_GKDE_EYE_INLINE];
+} cdl_gkde_eye;
+
+/* Builds the record of eye vertex y (neither the camera nor delta). */
+void cdl_gkde_eye_init(const cdl_gkde_ctx *g, uint32_t y, cdl_gkde_eye *e);
+
 /* What the strategy weight of a link reuses from its score. */
 typedef struct cdl_gkde_link_state {
-    cdl_gkde_vertex yv;
+    const cdl_gkde_eye *ye;
     float p_sa; /* x_{k-1} sampling the direction to y */
 } cdl_gkde_link_state;
 
@@ -94,7 +113,8 @@ typedef struct cdl_gkde_link_state {
  * divides by nothing more than the acceptance probability). Black when
  * the link cannot carry light (a BSDF or cosine is zero); ls is filled
  * otherwise. */
-cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, uint32_t y, cdl_gkde_link_state *ls);
+cdl_vec3 cdl_gkde_link(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_eye *ye,
+                       cdl_gkde_link_state *ls);
 /* Its weight among every strategy that samples the same path (eq. 9
  * generalized): computed only for links found unoccluded. */
 float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, const cdl_gkde_link_state *ls);
