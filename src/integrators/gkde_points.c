@@ -249,23 +249,21 @@ static void score_links(gkde_state *s, link_ctx *lc);
 static void link_point(link_ctx *c, uint32_t q)
 {
     gkde_state *s = c->s;
-    float w = 1.0f;
-    if (s->scale[q] > 0.0) {
-        cdl_strat st = {s->scale[q], s->cum[q]};
-        uint32_t k = cdl_strat_next(&st, c->a);
-        s->cum[q] = st.cum;
-        if (!k)
-            return;
-        w = (float)((double)k / (c->a * s->scale[q])); /* drawn k times, expected a m / W */
-    }
     if (c->n == MAX_BUNDLE) {
         score_links(s, c);
         c->n = 0;
     }
+    /* branch-free (most candidates are drawn no time, unpredictably): a
+     * point with scale 0 takes every candidate once, at weight 1 */
+    double sc = s->scale[q], ev = c->a * sc;
+    cdl_strat st = {sc, s->cum[q]};
+    uint32_t k = cdl_strat_next(&st, c->a);
+    s->cum[q] = st.cum;
+    k = sc > 0.0 ? k : 1;
     c->q[c->n] = q;
-    c->w[c->n] = w;
-    c->n++;
-    c->trials++;
+    c->w[c->n] = (float)((double)k / (sc > 0.0 ? ev : 1.0)); /* drawn k times, expected a m / W */
+    c->n += k > 0;
+    c->trials += k > 0;
 }
 
 #define PREFETCH 8 /* links ahead: a record is a few cache lines anywhere in the part */
@@ -392,7 +390,8 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
     }
     s->rec_bytes = rec_bytes;
     /* stage 4's plan: M / P_vis draws, or every candidate */
-    double cand = 0.0;
+    uint64_t cand = 0;
+#pragma omp parallel for schedule(static) reduction(+ : cand)
     for (uint32_t q = 0; q < n; q++) {
         uint32_t y = gkde_point_vertex(s, q);
         const uint32_t *pv = &s->pv[gkde_pv_bucket(s, y)];
@@ -406,7 +405,7 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
     }
     double t1 = cdl_time_now();
     s->st.t_count += t1 - t0;
-    s->st.candidates += cand;
+    s->st.candidates += (double)cand;
     /* stages 4 and 5: trial links, shadow-ray bundles, scores */
     double t_link = 0.0, t_rays = 0.0, t_score = 0.0;
     uint64_t trials = 0, rays = 0;

@@ -1,6 +1,7 @@
 #include "spatial/pointkd.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -38,7 +39,10 @@ static void select_kth(const cdl_kdtree *t, uint32_t *idx, uint32_t lo, uint32_t
     }
 }
 
-static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi)
+#define TASK_MIN 32768 /* subtrees this big are built as tasks of their own */
+
+/* tasks: inside a parallel region whose tasks may take subtrees */
+static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi, int tasks)
 {
     while (hi - lo > 1) {
         float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -55,7 +59,12 @@ static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi)
         uint32_t mid = lo + (hi - lo) / 2;
         select_kth(t, t->idx, lo, hi, mid, a);
         t->axis[mid] = (uint8_t)a;
-        build(t, lo, mid); /* recursion depth is log2(n) */
+        if (tasks && mid - lo >= TASK_MIN) {
+#pragma omp task firstprivate(lo, mid)
+            build(t, lo, mid, 1);
+        } else {
+            build(t, lo, mid, 0); /* recursion depth is log2(n) */
+        }
         lo = mid + 1;
     }
     if (hi - lo == 1)
@@ -80,7 +89,14 @@ int cdl_kd_build(cdl_kdtree *t, const float *pts, uint32_t stride, uint32_t n, c
     for (uint32_t i = 0; i < n; i++)
         t->idx[i] = i;
     t->n = n;
-    build(t, 0, n);
+    if (n >= 2 * TASK_MIN && !omp_in_parallel()) {
+        /* the subtrees are disjoint: the same tree whatever the threads */
+#pragma omp parallel
+#pragma omp single
+        build(t, 0, n, 1);
+    } else {
+        build(t, 0, n, 0);
+    }
     return 0;
 }
 
