@@ -86,7 +86,7 @@ void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *p
  * reads one record (in the eye points' tree order, so the candidates of a
  * footprint sit together) instead of the scattered store, and y's BSDF is
  * built once, not once per link. */
-#define CDL_GKDE_EYE_INLINE 4
+#define CDL_GKDE_EYE_INLINE 8
 typedef struct cdl_gkde_eye {
     cdl_bsdf b;
     cdl_vec3 p, ns, beta;
