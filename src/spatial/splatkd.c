@@ -1,0 +1,520 @@
+#include "spatial/splatkd.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Node encoding (8 bytes): b & 3 < 3: interior, split axis b & 3, a the
+ * split coordinate's bits, right child at b >> 2 (the left one follows the
+ * node). b & 3 == 3: kind (b >> 2) & 3: leaf (a samples from b >> 4),
+ * empty, or culling node (a: octahedral mean normal, 16 bits per
+ * coordinate; b >> 16: C_max in 16 bits, rounded up; its child follows). */
+enum { KIND_LEAF = 0, KIND_EMPTY = 1, KIND_CULL = 2 };
+#define MAX_INDEX (1u << 28) /* samples, and nodes a right-child offset can reach */
+
+void cdl_skd_params_default(cdl_skd_params *p, float scene_diag)
+{
+    p->leaf_size = 16;
+    p->min_diag = 1e-5f * scene_diag;
+    p->cull_deg = 15.0f;
+    p->part_depth = 6;
+}
+
+static uint32_t fbits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static float bitsf(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/* Octahedral encoding of a unit vector, 16 bits per coordinate. */
+static uint32_t oct_encode(cdl_vec3 n)
+{
+    float s = fabsf(n.x) + fabsf(n.y) + fabsf(n.z);
+    float u = n.x / s, v = n.y / s;
+    if (n.z < 0.0f) {
+        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+        u = pu;
+        v = pv;
+    }
+    uint32_t qu = (uint32_t)lrintf((u * 0.5f + 0.5f) * 65535.0f);
+    uint32_t qv = (uint32_t)lrintf((v * 0.5f + 0.5f) * 65535.0f);
+    return qu | qv << 16;
+}
+
+static cdl_vec3 oct_decode(uint32_t e)
+{
+    float u = (float)(e & 0xffff) / 65535.0f * 2.0f - 1.0f, v = (float)(e >> 16) / 65535.0f * 2.0f - 1.0f;
+    float z = 1.0f - fabsf(u) - fabsf(v);
+    if (z < 0.0f) {
+        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+        u = pu;
+        v = pv;
+    }
+    return cdl_normalize(cdl_v3(u, v, z));
+}
+
+typedef struct builder {
+    cdl_skd *t;
+    const cdl_skd_params *prm;
+    uint32_t *idx; /* caller's indices, permuted in place */
+    const cdl_vec3 *p, *n;
+    const uint8_t *flags;
+    uint32_t cull_below; /* subtrees smaller than this may get a culling node */
+    float cos_cull;
+    int fail;
+} builder;
+
+static uint32_t push(builder *b, uint32_t a, uint32_t w)
+{
+    cdl_skd *t = b->t;
+    if (t->nnodes == t->cap) {
+        uint32_t cap = t->cap ? 2 * t->cap : 1024;
+        cdl_skd_node *nn = cap < MAX_INDEX ? realloc(t->nodes, sizeof *nn * cap) : NULL;
+        if (!nn) {
+            b->fail = 1;
+            return 0;
+        }
+        t->nodes = nn;
+        t->cap = cap;
+    }
+    t->nodes[t->nnodes] = (cdl_skd_node){a, w};
+    return t->nnodes++;
+}
+
+static float pc(const builder *b, uint32_t i, int a)
+{
+    const float *v = &b->p[i].x;
+    return v[a];
+}
+
+/* A culling node over idx[lo, hi) if every normal lies within the cone
+ * limit of their mean; returns 1 if one was pushed. */
+static int try_cull(builder *b, uint32_t lo, uint32_t hi)
+{
+    cdl_vec3 m = cdl_v3(0.0f, 0.0f, 0.0f);
+    for (uint32_t i = lo; i < hi; i++) {
+        if (b->flags && (b->flags[b->idx[i]] & CDL_SKD_TWO_SIDED))
+            return 0;
+        m = cdl_add(m, b->n[b->idx[i]]);
+    }
+    float len = cdl_length(m);
+    if (!(len > 0.0f))
+        return 0;
+    uint32_t code = oct_encode(cdl_scale(m, 1.0f / len));
+    cdl_vec3 r = oct_decode(code); /* the deviation is measured from what the node holds */
+    float cmin = 1.0f;
+    for (uint32_t i = lo; i < hi; i++) {
+        float c = cdl_dot(r, b->n[b->idx[i]]);
+        cmin = c < cmin ? c : cmin;
+    }
+    if (!(cmin >= b->cos_cull))
+        return 0;
+    /* C_max = sin(D_theta), a little larger for rounding, quantized upwards */
+    double s = sqrt(fmax(0.0, 1.0 - (double)cmin * cmin)) + 1e-4;
+    uint32_t q = (uint32_t)ceil((s < 1.0 ? s : 1.0) * 65535.0);
+    push(b, code, 3u | (uint32_t)KIND_CULL << 2 | q << 16);
+    return 1;
+}
+
+static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled, uint32_t depth)
+{
+    cdl_skd *t = b->t;
+    if (b->fail)
+        return;
+    if (depth > t->depth)
+        t->depth = depth;
+    if (lo == hi) {
+        push(b, 0, 3u | (uint32_t)KIND_EMPTY << 2);
+        t->empties++;
+        return;
+    }
+    if (!culled && b->cos_cull > -2.0f && hi - lo < b->cull_below && try_cull(b, lo, hi)) {
+        culled = 1;
+        t->culls++;
+    }
+    float d[3] = {mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]};
+    float diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    uint32_t mid = lo;
+    int axis = -1;
+    float split = 0.0f;
+    if (hi - lo > b->prm->leaf_size && diag >= b->prm->min_diag) {
+        /* axes by cell extent, widest first; the first that separates */
+        int order[3] = {0, 1, 2};
+        for (int i = 0; i < 3; i++)
+            for (int j = i + 1; j < 3; j++)
+                if (d[order[j]] > d[order[i]]) {
+                    int tmp = order[i];
+                    order[i] = order[j];
+                    order[j] = tmp;
+                }
+        for (int k = 0; k < 3 && axis < 0; k++) {
+            int a = order[k];
+            float sp = 0.5f * (mn[a] + mx[a]), lo_c = INFINITY, hi_c = -INFINITY;
+            uint32_t left = 0;
+            for (uint32_t i = lo; i < hi; i++) {
+                float c = pc(b, b->idx[i], a);
+                left += c < sp;
+                lo_c = c < lo_c ? c : lo_c;
+                hi_c = c > hi_c ? c : hi_c;
+            }
+            if (!(hi_c > lo_c))
+                continue; /* every sample at the same coordinate */
+            /* a half with no sample: the plane moves to the sample nearest
+             * the median, and the empty side becomes an empty node */
+            int le = 0; /* left: c < sp, or c <= sp */
+            if (left == 0) {
+                sp = lo_c;
+            } else if (left == hi - lo) {
+                sp = hi_c;
+                le = 1;
+            }
+            uint32_t i = lo, j = hi;
+            while (i < j) {
+                float c = pc(b, b->idx[i], a);
+                if (le ? c <= sp : c < sp) {
+                    i++;
+                } else {
+                    uint32_t tmp = b->idx[i];
+                    b->idx[i] = b->idx[--j];
+                    b->idx[j] = tmp;
+                }
+            }
+            axis = a;
+            split = sp;
+            mid = i;
+        }
+    }
+    if (axis < 0) {
+        push(b, hi - lo, 3u | (uint32_t)KIND_LEAF << 2 | lo << 4);
+        t->leaves++;
+        return;
+    }
+    uint32_t node = push(b, fbits(split), (uint32_t)axis);
+    float keep = mx[axis];
+    mx[axis] = split;
+    build(b, lo, mid, mn, mx, culled, depth + 1);
+    mx[axis] = keep;
+    if (b->fail)
+        return;
+    if (t->nnodes >= MAX_INDEX) {
+        b->fail = 1;
+        return;
+    }
+    t->nodes[node].b |= t->nnodes << 2;
+    keep = mn[axis];
+    mn[axis] = split;
+    build(b, mid, hi, mn, mx, culled, depth + 1);
+    mn[axis] = keep;
+}
+
+static void add_part(cdl_skd *t, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
+{
+    cdl_skd_part *p = &t->parts[t->nparts++];
+    p->node = node;
+    p->lo = lo;
+    p->hi = hi;
+    memcpy(p->bmin, mn, sizeof p->bmin);
+    memcpy(p->bmax, mx, sizeof p->bmax);
+}
+
+/* Sample range of the subtree at node (its nodes end where the range's
+ * last leaf is). */
+static void subtree_range(const cdl_skd *t, uint32_t node, uint32_t *lo, uint32_t *hi)
+{
+    for (;;) {
+        cdl_skd_node nd = t->nodes[node];
+        if ((nd.b & 3) < 3) {
+            uint32_t l0, l1, r0, r1;
+            subtree_range(t, node + 1, &l0, &l1);
+            subtree_range(t, nd.b >> 2, &r0, &r1);
+            *lo = l0 < r0 ? l0 : r0;
+            *hi = l1 > r1 ? l1 : r1;
+            if (l0 == l1) {
+                *lo = r0;
+                *hi = r1;
+            } else if (r0 == r1) {
+                *lo = l0;
+                *hi = l1;
+            }
+            return;
+        }
+        uint32_t kind = (nd.b >> 2) & 3;
+        if (kind == KIND_CULL) {
+            node++;
+            continue;
+        }
+        if (kind == KIND_LEAF) {
+            *lo = nd.b >> 4;
+            *hi = *lo + nd.a;
+        } else {
+            *lo = *hi = 0;
+        }
+        return;
+    }
+}
+
+static void make_parts(cdl_skd *t, uint32_t node, float *mn, float *mx, uint32_t depth)
+{
+    cdl_skd_node nd = t->nodes[node];
+    if (depth == 0 || (nd.b & 3) == 3) {
+        uint32_t lo, hi;
+        subtree_range(t, node, &lo, &hi);
+        add_part(t, node, lo, hi, mn, mx);
+        return;
+    }
+    int a = (int)(nd.b & 3);
+    float s = bitsf(nd.a), keep = mx[a];
+    mx[a] = s;
+    make_parts(t, node + 1, mn, mx, depth - 1);
+    mx[a] = keep;
+    keep = mn[a];
+    mn[a] = s;
+    make_parts(t, nd.b >> 2, mn, mx, depth - 1);
+    mn[a] = keep;
+}
+
+int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_t *flags, uint32_t n_samples,
+                  const cdl_skd_params *prm, cdl_error *err)
+{
+    memset(t, 0, sizeof *t);
+    if (n_samples >= MAX_INDEX)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "splat kd-tree: %u eye samples, at most %u", n_samples,
+                             MAX_INDEX - 1);
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < n_samples; i++) {
+        const float *v = &p[i].x;
+        if (!cdl_is_finite3(p[i]) || !cdl_is_finite3(n[i]))
+            return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "splat kd-tree: eye sample %u is not finite", i);
+        for (int a = 0; a < 3; a++) {
+            mn[a] = v[a] < mn[a] ? v[a] : mn[a];
+            mx[a] = v[a] > mx[a] ? v[a] : mx[a];
+        }
+    }
+    if (!n_samples)
+        for (int a = 0; a < 3; a++)
+            mn[a] = mx[a] = 0.0f;
+    memcpy(t->bmin, mn, sizeof mn);
+    memcpy(t->bmax, mx, sizeof mx);
+    size_t m = n_samples ? n_samples : 1;
+    t->order = malloc(sizeof(uint32_t) * m);
+    t->flags = malloc(m);
+    for (int a = 0; a < 3; a++) {
+        t->p[a] = malloc(sizeof(float) * m);
+        t->nrm[a] = malloc(sizeof(float) * m);
+    }
+    t->parts = malloc(sizeof(cdl_skd_part) << prm->part_depth);
+    int ok = t->order && t->flags && t->parts;
+    for (int a = 0; a < 3; a++)
+        ok = ok && t->p[a] && t->nrm[a];
+    if (!ok) {
+        cdl_skd_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
+    }
+    t->n = n_samples;
+    for (uint32_t i = 0; i < n_samples; i++)
+        t->order[i] = i;
+    builder b = {t, prm, t->order, p, n, flags, 0, -3.0f, 0};
+    if (prm->cull_deg >= 0.0f) {
+        b.cos_cull = cosf(prm->cull_deg * (float)(CDL_PI / 180.0));
+        b.cull_below = (uint32_t)ceil(sqrt((double)n_samples)); /* 2^(0.5 log2 N) */
+    }
+    float bmn[3], bmx[3];
+    memcpy(bmn, mn, sizeof bmn);
+    memcpy(bmx, mx, sizeof bmx);
+    build(&b, 0, n_samples, bmn, bmx, 0, 0);
+    if (b.fail) {
+        cdl_skd_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
+    }
+    for (uint32_t i = 0; i < n_samples; i++) {
+        uint32_t s = t->order[i];
+        const float *v = &p[s].x, *w = &n[s].x;
+        for (int a = 0; a < 3; a++) {
+            t->p[a][i] = v[a];
+            t->nrm[a][i] = w[a];
+        }
+        t->flags[i] = flags ? flags[s] : 0;
+    }
+    memcpy(bmn, mn, sizeof bmn);
+    memcpy(bmx, mx, sizeof bmx);
+    make_parts(t, 0, bmn, bmx, prm->part_depth);
+    return 0;
+}
+
+void cdl_skd_free(cdl_skd *t)
+{
+    free(t->nodes);
+    free(t->order);
+    free(t->flags);
+    for (int a = 0; a < 3; a++) {
+        free(t->p[a]);
+        free(t->nrm[a]);
+    }
+    free(t->parts);
+    memset(t, 0, sizeof *t);
+}
+
+size_t cdl_skd_bytes(const cdl_skd *t)
+{
+    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->n * (4 + 1 + 6 * sizeof(float)) +
+           (size_t)t->nparts * sizeof(cdl_skd_part);
+}
+
+static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float z)
+{
+    if (out->n == out->cap) {
+        uint32_t cap = out->cap ? 2 * out->cap : 4096;
+        cdl_splat_hit *h = realloc(out->h, sizeof *h * cap);
+        if (!h) {
+            out->fail = 1;
+            return -1;
+        }
+        out->h = h;
+        out->cap = cap;
+    }
+    out->h[out->n++] = (cdl_splat_hit){s, w, z};
+    return 0;
+}
+
+static int test_range(const cdl_skd *t, uint32_t lo, uint32_t hi, const cdl_splat_ray *r, cdl_splat_hits *out)
+{
+    out->tested += hi - lo;
+    for (uint32_t i = lo; i < hi; i++) {
+        float z;
+        float w = cdl_splat_weight(r, cdl_v3(t->p[0][i], t->p[1][i], t->p[2][i]),
+                                   cdl_v3(t->nrm[0][i], t->nrm[1][i], t->nrm[2][i]), t->flags[i], &z);
+        if (w > 0.0f && add_hit(out, i, w, z))
+            return -1;
+    }
+    return 0;
+}
+
+typedef struct trav {
+    const cdl_skd *t;
+    const cdl_splat_ray *r;
+    float o[3], d[3];
+    int cull;
+    cdl_splat_hits *out;
+} trav;
+
+/* Radius of the frustum at distance t (the cap keeps the hit's radius). */
+static float radius_at(const cdl_splat_ray *r, float t) { return r->h0 + r->dh * (t < r->len ? t : r->len); }
+
+/* Algorithm 1: node over the ray interval [t0, t1]. */
+static int traverse(const trav *v, uint32_t node, float t0, float t1)
+{
+    const cdl_skd *t = v->t;
+    for (;;) {
+        v->out->nodes++;
+        cdl_skd_node nd = t->nodes[node];
+        uint32_t ty = nd.b & 3;
+        if (ty == 3) {
+            uint32_t kind = (nd.b >> 2) & 3;
+            if (kind == KIND_LEAF) {
+                uint32_t lo = nd.b >> 4;
+                return test_range(t, lo, lo + nd.a, v->r, v->out);
+            }
+            if (kind == KIND_EMPTY)
+                return 0;
+            /* culling node: every sample faces away from the ray */
+            if (v->cull) {
+                float cmax = (float)(nd.b >> 16) / 65535.0f;
+                if (cdl_dot(v->r->d, oct_decode(nd.a)) >= cmax)
+                    return 0;
+            }
+            node++;
+            continue;
+        }
+        int a = (int)ty;
+        float s = bitsf(nd.a), R1 = radius_at(v->r, t1);
+        uint32_t left = node + 1, right = nd.b >> 2;
+        if (v->d[a] == 0.0f) {
+            int go_l = v->o[a] - R1 <= s, go_r = v->o[a] + R1 >= s;
+            if (go_l && go_r) {
+                if (traverse(v, left, t0, t1))
+                    return -1;
+                node = right;
+            } else {
+                node = go_l ? left : right;
+            }
+            continue;
+        }
+        float tp = (s - v->o[a]) / v->d[a], dt = R1 / fabsf(v->d[a]);
+        float ta = tp - dt, tb = tp + dt;
+        uint32_t front = v->d[a] > 0.0f ? left : right, back = v->d[a] > 0.0f ? right : left;
+        int go_f = t0 <= tb, go_b = t1 >= ta;
+        if (go_f && go_b) {
+            if (traverse(v, front, t0, tb < t1 ? tb : t1))
+                return -1;
+            node = back;
+            t0 = ta > t0 ? ta : t0;
+        } else if (go_f) {
+            node = front;
+            t1 = tb < t1 ? tb : t1;
+        } else if (go_b) {
+            node = back;
+            t0 = ta > t0 ? ta : t0;
+        } else {
+            return 0;
+        }
+    }
+}
+
+int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_splat_hits *out)
+{
+    if (!t->n)
+        return 0;
+    uint32_t root = 0;
+    const float *mn = t->bmin, *mx = t->bmax;
+    if (part != UINT32_MAX) {
+        if (part >= t->nparts)
+            return 0;
+        root = t->parts[part].node;
+        mn = t->parts[part].bmin;
+        mx = t->parts[part].bmax;
+    }
+    trav v = {t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, cull, out};
+    /* clip [0, len + h(len)] by the box grown by the largest radius */
+    float hmax = radius_at(r, r->len), t0 = 0.0f, t1 = r->len + hmax;
+    for (int a = 0; a < 3; a++) {
+        float lo = mn[a] - hmax, hi = mx[a] + hmax;
+        if (v.d[a] == 0.0f) {
+            if (v.o[a] < lo || v.o[a] > hi)
+                return 0;
+            continue;
+        }
+        float inv = 1.0f / v.d[a], ta = (lo - v.o[a]) * inv, tb = (hi - v.o[a]) * inv;
+        if (ta > tb) {
+            float tmp = ta;
+            ta = tb;
+            tb = tmp;
+        }
+        t0 = ta > t0 ? ta : t0;
+        t1 = tb < t1 ? tb : t1;
+    }
+    if (t0 > t1)
+        return 0;
+    return traverse(&v, root, t0, t1) || out->fail ? -1 : 0;
+}
+
+int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, cdl_splat_hits *out)
+{
+    uint32_t lo = 0, hi = t->n;
+    if (part != UINT32_MAX) {
+        if (part >= t->nparts)
+            return 0;
+        lo = t->parts[part].lo;
+        hi = t->parts[part].hi;
+    }
+    return test_range(t, lo, hi, r, out);
+}

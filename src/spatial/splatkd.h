@@ -1,0 +1,119 @@
+/* The eye-sample kd-tree of photon ray splatting (Herzog et al. 2007, §5):
+ * eye samples (points with the normal of the side the camera sees) under
+ * a kd-tree that a photon ray traverses with its conical frustum
+ * (Algorithm 1), every eye sample inside it tested for feasibility and
+ * weighted by the ray-space Epanechnikov kernel (Algorithm 2, eq. 4.5).
+ *
+ * Layout (§5.1): 8-byte nodes in depth-first order, the left child next
+ * to its parent; interior nodes split at the spatial median of their cell
+ * (at the sample nearest to it when a side would be empty); leaves of at
+ * most 16 samples or a cell too small to split; empty nodes; and
+ * back-face-culling nodes holding a mean normal and C_max = sin(D_theta)
+ * over a subtree whose normals deviate by less than 15 degrees. The
+ * samples are kept in tree order (structure of arrays); the tree splits
+ * into parts (subtrees, a fixed number whatever the threads) that a thread
+ * owns, each with a contiguous range of samples. */
+#ifndef CDL_SPLATKD_H
+#define CDL_SPLATKD_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/vec.h"
+
+typedef struct cdl_skd_node {
+    uint32_t a, b;
+} cdl_skd_node;
+
+enum { CDL_SKD_TWO_SIDED = 1 }; /* a sample that receives light from both sides (transmission) */
+
+typedef struct cdl_skd_part {
+    uint32_t node, lo, hi; /* root node; samples [lo, hi) */
+    float bmin[3], bmax[3];
+} cdl_skd_part;
+
+typedef struct cdl_skd {
+    cdl_skd_node *nodes;
+    uint32_t nnodes, cap;
+    uint32_t n;
+    uint32_t *order; /* caller's index of the sample at each tree position */
+    float *p[3], *nrm[3];
+    uint8_t *flags;
+    float bmin[3], bmax[3];
+    cdl_skd_part *parts;
+    uint32_t nparts;
+    uint32_t leaves, culls, empties, depth;
+} cdl_skd;
+
+typedef struct cdl_skd_params {
+    uint32_t leaf_size;     /* 16 */
+    float min_diag;         /* cells with a smaller diagonal become leaves (scene units) */
+    float cull_deg;         /* 15; a negative value: no culling nodes */
+    uint32_t part_depth;    /* parts are the subtrees this many levels down (6) */
+} cdl_skd_params;
+
+void cdl_skd_params_default(cdl_skd_params *p, float scene_diag);
+
+/* Builds over n samples (position, unit normal of the seen side, flags).
+ * Non-finite input is an error. */
+int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_t *flags, uint32_t n_samples,
+                  const cdl_skd_params *prm, cdl_error *err);
+void cdl_skd_free(cdl_skd *t);
+size_t cdl_skd_bytes(const cdl_skd *t);
+
+/* A photon ray x_{i-1} -> x_i with its bandwidth (§4.2): radius h0 + dh t
+ * at distance t along it up to the hit, a hemisphere of radius h(len)
+ * beyond it. on: the normal at the origin's front (samples behind the
+ * origin surface get nothing); zero for a point light. */
+typedef struct cdl_splat_ray {
+    cdl_vec3 o, d, on;
+    float len, h0, dh;
+} cdl_splat_ray;
+
+/* A feasible eye sample: its tree position, kernel times cosine (per unit
+ * flux: the irradiance it receives) and its distance along the ray. */
+typedef struct cdl_splat_hit {
+    uint32_t s;
+    float w, z;
+} cdl_splat_hit;
+
+typedef struct cdl_splat_hits {
+    cdl_splat_hit *h;
+    uint32_t n, cap;
+    uint64_t tested; /* samples tested (feasible or not) */
+    uint64_t nodes;  /* nodes visited */
+    int fail;        /* out of memory */
+} cdl_splat_hits;
+
+/* Weight of the sample at p (normal n, flags) for ray r (Algorithm 2):
+ * 0 when infeasible: facing away, behind the origin surface, beyond the
+ * frustum or the hemispherical cap. */
+static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec3 n, uint8_t flags, float *z_out)
+{
+    float c = cdl_dot(r->d, n);
+    if (flags & CDL_SKD_TWO_SIDED)
+        c = -fabsf(c);
+    if (!(c < 0.0f))
+        return 0.0f;
+    cdl_vec3 D = cdl_sub(p, r->o);
+    float z = cdl_dot(D, r->d);
+    if (!(z >= 0.0f) || cdl_dot(D, r->on) < 0.0f)
+        return 0.0f;
+    float h = r->h0 + r->dh * (z < r->len ? z : r->len);
+    float h2 = h * h;
+    float r2 = cdl_dot(D, D) - z * z;
+    if (z > r->len)
+        h2 -= (z - r->len) * (z - r->len);
+    if (!(h2 > 0.0f) || r2 >= h2)
+        return 0.0f;
+    *z_out = z;
+    return (float)(2.0 / CDL_PI) / h2 * (1.0f - (r2 > 0.0f ? r2 : 0.0f) / h2) * -c;
+}
+
+/* Appends the feasible samples of part `part` (UINT32_MAX: the whole tree)
+ * to out, traversing with the frustum. Returns 0, or -1 out of memory. */
+int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_splat_hits *out);
+/* The same by testing every sample of the part (for tests). */
+int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, cdl_splat_hits *out);
+
+#endif

@@ -1,0 +1,208 @@
+/* The eye-sample kd-tree of photon ray splatting (spatial/splatkd.c): the
+ * frustum traversal (Algorithm 1), with and without culling nodes, whole
+ * or part by part, finds exactly the feasible samples brute force finds,
+ * with the same weights; the layout keeps its promises (8-byte nodes,
+ * small leaves, culling nodes on coherent normals); parallel photon rays
+ * onto a plane give the exact irradiance; a sample never receives light
+ * from the side it does not show. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/rng.h"
+#include "spatial/splatkd.h"
+#include "test_util.h"
+
+static cdl_vec3 rand_dir(cdl_rng *r)
+{
+    float z = 1.0f - 2.0f * cdl_rng_float(r), phi = 2.0f * (float)CDL_PI * cdl_rng_float(r);
+    float s = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    return cdl_v3(s * cosf(phi), s * sinf(phi), z);
+}
+
+/* Samples on three walls of a unit box, a floor and a sphere; some two-sided. */
+static uint32_t make_samples(cdl_rng *r, uint32_t n, cdl_vec3 *p, cdl_vec3 *nr, uint8_t *fl)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        float u = cdl_rng_float(r), v = cdl_rng_float(r);
+        fl[i] = 0;
+        switch (i % 5) {
+        case 0: p[i] = cdl_v3(u, 0.0f, v), nr[i] = cdl_v3(0, 1, 0); break;
+        case 1: p[i] = cdl_v3(0.0f, u, v), nr[i] = cdl_v3(1, 0, 0); break;
+        case 2: p[i] = cdl_v3(u, v, 0.0f), nr[i] = cdl_v3(0, 0, 1); break;
+        case 3: {
+            cdl_vec3 d = rand_dir(r);
+            p[i] = cdl_add(cdl_v3(0.5f, 0.4f, 0.5f), cdl_scale(d, 0.2f));
+            nr[i] = d;
+            break;
+        }
+        default: /* a thin two-sided panel */
+            p[i] = cdl_v3(0.7f, 0.2f + 0.3f * u, 0.2f + 0.3f * v), nr[i] = cdl_v3(-1, 0, 0);
+            fl[i] = CDL_SKD_TWO_SIDED;
+            break;
+        }
+    }
+    return n;
+}
+
+static int cmp_hit(const void *a, const void *b)
+{
+    const cdl_splat_hit *x = a, *y = b;
+    return (x->s > y->s) - (x->s < y->s);
+}
+
+static void traversal(void)
+{
+    cdl_rng r;
+    cdl_rng_seed(&r, 5, 7);
+    uint32_t n = 20000;
+    cdl_vec3 *p = malloc(sizeof *p * n), *nr = malloc(sizeof *nr * n);
+    uint8_t *fl = malloc(n);
+    make_samples(&r, n, p, nr, fl);
+    cdl_skd t;
+    cdl_skd_params prm;
+    cdl_skd_params_default(&prm, sqrtf(3.0f));
+    cdl_error err;
+    die_on(cdl_skd_build(&t, p, nr, fl, n, &prm, &err), &err);
+    CHECK(sizeof(cdl_skd_node) == 8, "8-byte nodes");
+    uint32_t big = 0, covered = 0;
+    for (uint32_t i = 0; i < t.nnodes; i++)
+        if ((t.nodes[i].b & 15) == 3) {
+            big += t.nodes[i].a > prm.leaf_size;
+            covered += t.nodes[i].a;
+        }
+    CHECK(big == 0 && covered == n && t.culls > 0 && t.empties > 0,
+          "%u leaves hold all %u samples, none over %u; %u culling and %u empty nodes, depth %u", t.leaves, covered,
+          prm.leaf_size, t.culls, t.empties, t.depth);
+    uint32_t parts_cover = 0;
+    for (uint32_t k = 0; k < t.nparts; k++)
+        parts_cover += t.parts[k].hi - t.parts[k].lo;
+    CHECK(parts_cover == n && t.nparts > 8, "%u parts cover the samples once", t.nparts);
+    cdl_splat_hits a = {0}, b = {0}, c = {0};
+    uint32_t wrong = 0, total = 0, wdiff = 0;
+    uint64_t tested_cull = 0, tested_plain = 0;
+    for (int k = 0; k < 600; k++) {
+        cdl_splat_ray ray;
+        ray.o = cdl_v3(1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f);
+        ray.d = rand_dir(&r);
+        ray.on = k % 3 ? cdl_v3(0, 0, 0) : rand_dir(&r);
+        ray.len = 1.5f * cdl_rng_float(&r);
+        ray.h0 = 0.1f * cdl_rng_float(&r);
+        ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
+        a.n = b.n = c.n = 0;
+        cdl_skd_splat_brute(&t, UINT32_MAX, &ray, &a);
+        uint64_t t0 = b.tested;
+        cdl_skd_splat(&t, UINT32_MAX, &ray, 1, &b);
+        tested_cull += b.tested - t0;
+        t0 = c.tested;
+        for (uint32_t q = 0; q < t.nparts; q++)
+            cdl_skd_splat(&t, q, &ray, k % 4 == 0, &c);
+        tested_plain += c.tested - t0;
+        qsort(a.h, a.n, sizeof *a.h, cmp_hit);
+        qsort(b.h, b.n, sizeof *b.h, cmp_hit);
+        qsort(c.h, c.n, sizeof *c.h, cmp_hit);
+        total += a.n;
+        if (a.n != b.n || a.n != c.n) {
+            wrong++;
+            continue;
+        }
+        for (uint32_t i = 0; i < a.n; i++) {
+            wrong += a.h[i].s != b.h[i].s || a.h[i].s != c.h[i].s;
+            wdiff += a.h[i].w != b.h[i].w || a.h[i].w != c.h[i].w;
+        }
+    }
+    CHECK(wrong == 0 && wdiff == 0 && total > 20000,
+          "frustum traversal = brute force over 600 rays (%u feasible samples, %u wrong, %u weights differ)", total,
+          wrong, wdiff);
+    CHECK(tested_cull < 20ull * total, "the traversal tests few samples per feasible one (%.2f)",
+          (double)tested_cull / total);
+    (void)tested_plain;
+    free(a.h);
+    free(b.h);
+    free(c.h);
+    cdl_skd_free(&t);
+    free(p);
+    free(nr);
+    free(fl);
+}
+
+/* Expected irradiance of parallel rays at angle theta onto a plane, as a
+ * fraction of the exact phi / g^2 cos(theta): rays ending before a sample
+ * reach it through the hemispherical cap of Algorithm 2, whose kernel is
+ * renormalized over the cap's cross-section: exact at normal incidence,
+ * low at oblique ones, 1/2 + cos(theta) 8/(3 pi) int_0^1 (1 - s^2)^(3/2) /
+ * (1 - s^2 sin^2(theta))^2 ds. */
+static double cap_factor(double theta)
+{
+    double sum = 0.0, sn = sin(theta);
+    int n = 100000;
+    for (int i = 0; i < n; i++) {
+        double s = (i + 0.5) / n, q = 1.0 - s * s * sn * sn;
+        sum += pow(1.0 - s * s, 1.5) / (q * q);
+    }
+    return 0.5 + cos(theta) * 8.0 / (3.0 * CDL_PI) * sum / n;
+}
+
+/* Parallel rays of flux phi each, one per cell of a jittered grid of
+ * spacing g across the beam, onto the plane y = 0 at angle theta: the
+ * irradiance phi / g^2 cos(theta) (times the cap's factor) away from the
+ * edges, and nothing for a plane facing away. */
+static void irradiance(float theta)
+{
+    cdl_rng r;
+    cdl_rng_seed(&r, 8, 1);
+    uint32_t n = 400;
+    cdl_vec3 p[400], nr[400];
+    for (uint32_t i = 0; i < n; i++) {
+        p[i] = cdl_v3(0.4f + 0.2f * cdl_rng_float(&r), 0.0f, 0.4f + 0.2f * cdl_rng_float(&r));
+        nr[i] = cdl_v3(0, 1, 0);
+    }
+    cdl_skd t;
+    cdl_skd_params prm;
+    cdl_skd_params_default(&prm, 1.0f);
+    cdl_error err;
+    die_on(cdl_skd_build(&t, p, nr, NULL, n, &prm, &err), &err);
+    double *E = calloc(n, sizeof *E), *B = calloc(n, sizeof *B);
+    float g = 0.004f, h = 0.05f;
+    cdl_vec3 d = cdl_v3(sinf(theta), -cosf(theta), 0.0f);
+    cdl_splat_hits hits = {0};
+    for (int backside = 0; backside < 2; backside++) {
+        for (int i = -150; i <= 150; i++)
+            for (int j = -150; j <= 150; j++) {
+                float a = ((float)i + cdl_rng_float(&r) - 0.5f) * g, b = ((float)j + cdl_rng_float(&r) - 0.5f) * g;
+                cdl_vec3 hit = cdl_v3(0.5f + a / cosf(theta), 0.0f, 0.5f + b);
+                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f};
+                if (backside) { /* from below: the samples show their top */
+                    ray.d = cdl_neg(d);
+                    ray.o = cdl_add(hit, cdl_scale(d, 2.0f));
+                }
+                hits.n = 0;
+                cdl_skd_splat(&t, UINT32_MAX, &ray, 1, &hits);
+                for (uint32_t k = 0; k < hits.n; k++)
+                    (backside ? B : E)[hits.h[k].s] += hits.h[k].w;
+            }
+    }
+    double want = 1.0 / ((double)g * g) * cos(theta) * cap_factor(theta), mean = 0.0, worst = 0.0, back = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        mean += E[i] / n;
+        worst = fmax(worst, fabs(E[i] / want - 1.0));
+        back += B[i];
+    }
+    CHECK(fabs(mean / want - 1.0) < 0.01 && worst < 0.05,
+          "parallel rays at %.2f rad: irradiance %.5g per unit flux, expected %.5g (cap factor %.4f; mean ratio "
+          "%.4f, worst sample off by %.3f)",
+          (double)theta, mean, want, cap_factor(theta), mean / want, worst);
+    CHECK(back == 0.0, "rays from the side a sample does not show give it nothing (%g)", back);
+    free(E);
+    free(B);
+    free(hits.h);
+    cdl_skd_free(&t);
+}
+
+int main(void)
+{
+    traversal();
+    irradiance(0.0f);
+    irradiance(0.6f);
+    return test_failures ? 1 : 0;
+}
