@@ -23,6 +23,7 @@
 #include "integrators/pm.h"
 #include "transport/light_select.h"
 #include "transport/photons.h"
+#include "transport/visible.h"
 
 typedef struct pm_state {
     const cdl_scene *scene;
@@ -202,101 +203,74 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
                          uint32_t *nlcon)
 {
     const cdl_scene *s = st->scene;
-    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f), beta = cdl_v3(1.0f, 1.0f, 1.0f);
-    for (int depth = 0;; depth++) {
-        cdl_hit h;
-        (*rays)++;
-        if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
-            if (s->env_light >= 0)
-                L = cdl_add(L, cdl_mul(beta, s->lights[s->env_light].L));
-            return L;
+    cdl_visible v;
+    if (!cdl_find_visible(s, o, d, st->opt.maxdepth, smp, rays, &v))
+        return v.L;
+    cdl_vec3 L = v.L, beta = v.beta, wo = v.wo;
+    const cdl_surface sf = v.sf;
+    const cdl_bsdf b = v.b;
+    int depth = v.depth;
+    if (st->opt.pm.direct_photons) {
+        /* the photon map seen directly, its primary photons the direct
+         * light (Jensen's visualization; Bekaert et al. 2003, Fig. 1) */
+        cdl_pm_query q = w->qgx;
+        q.max_depth = (uint32_t)(st->opt.maxdepth - depth);
+        w->qcx.max_depth = q.max_depth;
+        cdl_vec3 Lp = cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b);
+        if (st->caustic.n)
+            Lp = cdl_add(Lp, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
+        return cdl_add(L, cdl_mul(beta, Lp));
+    }
+    cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
+    if (depth + 1 < st->opt.maxdepth) {
+        /* --maxdepth counts the whole path: the photons here may have met
+         * as many surfaces as the camera path has bounces left */
+        uint32_t left = (uint32_t)(st->opt.maxdepth - depth);
+        w->qcx.max_depth = left;
+        if (st->caustic.n)
+            Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
+        uint32_t ng = st->opt.pm.gather;
+        if (!ng) {
+            cdl_pm_query q = w->qgx;
+            q.skip = CDL_PH_PRIMARY; /* light sampling has the direct part */
+            q.max_depth = left;
+            Lx = cdl_add(Lx, cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b));
         }
-        cdl_surface sf;
-        cdl_surface_at(s, &h, &sf);
-        cdl_bsdf b;
-        cdl_scene_bsdf(s, &sf, &b);
-        cdl_vec3 wo = cdl_neg(d);
-        if (sf.light >= 0)
-            L = cdl_add(L, cdl_mul(beta, cdl_light_Le(&s->lights[sf.light], sf.ng, wo)));
-        if (cdl_bsdf_is_delta(&b)) {
-            if (depth >= st->opt.maxdepth)
-                return L;
+        cdl_vec3 Lg = cdl_v3(0.0f, 0.0f, 0.0f);
+        for (uint32_t g = 0; g < ng; g++) {
             cdl_scatter sc;
             float u0 = cdl_sampler_1d(smp), u1, u2;
             cdl_sampler_2d(smp, &u1, &u2);
-            if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc))
-                return L;
-            beta = cdl_mul(beta, sc.weight);
-            if (cdl_is_black(beta))
-                return L;
-            o = cdl_offset(s, sf.p, sf.ng, sc.wi);
-            d = sc.wi;
-            continue;
-        }
-        if (depth >= st->opt.maxdepth)
-            return L;
-        if (st->opt.pm.direct_photons) {
-            /* the photon map seen directly, its primary photons the direct
-             * light (Jensen's visualization; Bekaert et al. 2003, Fig. 1) */
-            cdl_pm_query q = w->qgx;
-            q.max_depth = (uint32_t)(st->opt.maxdepth - depth);
-            w->qcx.max_depth = q.max_depth;
-            cdl_vec3 Lp = cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b);
-            if (st->caustic.n)
-                Lp = cdl_add(Lp, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
-            return cdl_add(L, cdl_mul(beta, Lp));
-        }
-        cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
-        if (depth + 1 < st->opt.maxdepth) {
-            /* --maxdepth counts the whole path: the photons here may have met
-             * as many surfaces as the camera path has bounces left */
-            uint32_t left = (uint32_t)(st->opt.maxdepth - depth);
-            w->qcx.max_depth = left;
-            if (st->caustic.n)
-                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->caustic, &w->qcx, sf.p, wo, &b));
-            uint32_t ng = st->opt.pm.gather;
-            if (!ng) {
-                cdl_pm_query q = w->qgx;
-                q.skip = CDL_PH_PRIMARY; /* light sampling has the direct part */
-                q.max_depth = left;
-                Lx = cdl_add(Lx, cdl_pmap_radiance(&st->global, &q, sf.p, wo, &b));
+            if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc) || cdl_is_black(sc.weight))
+                continue;
+            cdl_hit hg;
+            (*rays)++;
+            if (!cdl_intersect(s, cdl_offset(s, sf.p, sf.ng, sc.wi), sc.wi, FLT_MAX, &hg))
+                continue; /* the sky is direct light */
+            cdl_surface sg;
+            cdl_surface_at(s, &hg, &sg);
+            cdl_bsdf bg;
+            cdl_scene_bsdf(s, &sg, &bg);
+            if (cdl_bsdf_is_delta(&bg))
+                continue; /* specular then x: the caustic map's paths */
+            cdl_vec3 wg = cdl_neg(sc.wi);
+            int found = 0;
+            /* the points hold photons of up to maxdepth - 1 bounces: all a
+             * gather from the first vertex may use, more after a mirror
+             * unless no photon went that deep */
+            if (bg.type == CDL_MAT_DIFFUSE && st->irr.n && (depth == 0 || st->ph_depth <= left - 1)) {
+                cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
+                cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, st->vis_gather, &found);
+                if (found)
+                    Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
             }
-            cdl_vec3 Lg = cdl_v3(0.0f, 0.0f, 0.0f);
-            for (uint32_t g = 0; g < ng; g++) {
-                cdl_scatter sc;
-                float u0 = cdl_sampler_1d(smp), u1, u2;
-                cdl_sampler_2d(smp, &u1, &u2);
-                if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &sc) || cdl_is_black(sc.weight))
-                    continue;
-                cdl_hit hg;
-                (*rays)++;
-                if (!cdl_intersect(s, cdl_offset(s, sf.p, sf.ng, sc.wi), sc.wi, FLT_MAX, &hg))
-                    continue; /* the sky is direct light */
-                cdl_surface sg;
-                cdl_surface_at(s, &hg, &sg);
-                cdl_bsdf bg;
-                cdl_scene_bsdf(s, &sg, &bg);
-                if (cdl_bsdf_is_delta(&bg))
-                    continue; /* specular then x: the caustic map's paths */
-                cdl_vec3 wg = cdl_neg(sc.wi);
-                int found = 0;
-                /* the points hold photons of up to maxdepth - 1 bounces: all a
-                 * gather from the first vertex may use, more after a mirror
-                 * unless no photon went that deep */
-                if (bg.type == CDL_MAT_DIFFUSE && st->irr.n && (depth == 0 || st->ph_depth <= left - 1)) {
-                    cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
-                    cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, st->vis_gather, &found);
-                    if (found)
-                        Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
-                }
-                if (!found)
-                    Lg = cdl_add(Lg, cdl_mul(sc.weight, photon_radiance(st, w, &sg, &bg, wg, left - 1)));
-            }
-            if (ng)
-                Lx = cdl_add(Lx, cdl_scale(Lg, 1.0f / (float)ng));
+            if (!found)
+                Lg = cdl_add(Lg, cdl_mul(sc.weight, photon_radiance(st, w, &sg, &bg, wg, left - 1)));
         }
-        return cdl_add(L, cdl_mul(beta, Lx));
+        if (ng)
+            Lx = cdl_add(Lx, cdl_scale(Lg, 1.0f / (float)ng));
     }
+    return cdl_add(L, cdl_mul(beta, Lx));
 }
 
 static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int y1, uint32_t pass,
