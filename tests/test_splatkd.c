@@ -89,6 +89,7 @@ static void traversal(void)
         ray.len = 1.5f * cdl_rng_float(&r);
         ray.h0 = 0.1f * cdl_rng_float(&r);
         ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
+        ray.cap = k % 3 == 1 ? 0.0f : 4.0f;
         a.n = b.n = c.n = 0;
         cdl_skd_splat_brute(&t, UINT32_MAX, &ray, &a);
         uint64_t t0 = b.tested;
@@ -147,7 +148,7 @@ static double cap_factor(double theta)
  * spacing g across the beam, onto the plane y = 0 at angle theta: the
  * irradiance phi / g^2 cos(theta) (times the cap's factor) away from the
  * edges, and nothing for a plane facing away. */
-static void irradiance(float theta)
+static void irradiance(float theta, float cap)
 {
     cdl_rng r;
     cdl_rng_seed(&r, 8, 1);
@@ -171,7 +172,7 @@ static void irradiance(float theta)
             for (int j = -150; j <= 150; j++) {
                 float a = ((float)i + cdl_rng_float(&r) - 0.5f) * g, b = ((float)j + cdl_rng_float(&r) - 0.5f) * g;
                 cdl_vec3 hit = cdl_v3(0.5f + a / cosf(theta), 0.0f, 0.5f + b);
-                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f};
+                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f, cap};
                 if (backside) { /* from below: the samples show their top */
                     ray.d = cdl_neg(d);
                     ray.o = cdl_add(hit, cdl_scale(d, 2.0f));
@@ -182,16 +183,17 @@ static void irradiance(float theta)
                     (backside ? B : E)[hits.h[k].s] += hits.h[k].w;
             }
     }
-    double want = 1.0 / ((double)g * g) * cos(theta) * cap_factor(theta), mean = 0.0, worst = 0.0, back = 0.0;
+    double factor = cap > 0.0f ? 1.0 : cap_factor(theta);
+    double want = 1.0 / ((double)g * g) * cos(theta) * factor, mean = 0.0, worst = 0.0, back = 0.0;
     for (uint32_t i = 0; i < n; i++) {
         mean += E[i] / n;
         worst = fmax(worst, fabs(E[i] / want - 1.0));
         back += B[i];
     }
     CHECK(fabs(mean / want - 1.0) < 0.01 && worst < 0.05,
-          "parallel rays at %.2f rad: irradiance %.5g per unit flux, expected %.5g (cap factor %.4f; mean ratio "
-          "%.4f, worst sample off by %.3f)",
-          (double)theta, mean, want, cap_factor(theta), mean / want, worst);
+          "parallel rays at %.2f rad, %s cap: irradiance %.5g per unit flux, expected %.5g (factor %.4f; mean "
+          "ratio %.4f, worst sample off by %.3f)",
+          (double)theta, cap > 0.0f ? "tangent-plane" : "hemisphere", mean, want, factor, mean / want, worst);
     CHECK(back == 0.0, "rays from the side a sample does not show give it nothing (%g)", back);
     free(E);
     free(B);
@@ -202,7 +204,9 @@ static void irradiance(float theta)
 int main(void)
 {
     traversal();
-    irradiance(0.0f);
-    irradiance(0.6f);
+    irradiance(0.0f, 0.0f);
+    irradiance(0.6f, 0.0f);
+    irradiance(0.6f, 4.0f);
+    irradiance(1.2f, 4.0f);
     return test_failures ? 1 : 0;
 }

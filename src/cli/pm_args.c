@@ -96,7 +96,7 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
         else
             return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected gather, all or off, got '%s'", v);
     } else if (!strcmp(o, "--direct")) {
-        if (!strcmp(v, "power"))
+        if (!strcmp(v, "power") || !strcmp(v, "sample")) /* sample: splat's name for it */
             pm->direct = CDL_DIRECT_POWER;
         else if (!strcmp(v, "lcon"))
             pm->direct = CDL_DIRECT_LCON;
@@ -105,7 +105,7 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
         else if (!strcmp(v, "photons"))
             pm->direct_photons = 1;
         else
-            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power, lcon, lcon-biased or photons, got '%s'",
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power (or sample), lcon, lcon-biased or photons, got '%s'",
                                  v);
         if (strcmp(v, "photons"))
             pm->direct_photons = 0;

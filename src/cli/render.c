@@ -13,6 +13,7 @@
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "cli/gkde_args.h"
+#include "cli/splat_args.h"
 #include "cli/pm_args.h"
 #include "cli/render_args.h"
 #include "core/log.h"
@@ -69,6 +70,7 @@ static void render_help(void)
            "\n");
     cdl_pm_args_help();
     cdl_gkde_args_help();
+    cdl_splat_args_help();
     printf("Integrators:\n");
     for (const cdl_integrator_vtbl *const *it = cdl_integrator_list(); *it; it++)
         printf("  %-8s %s\n", (*it)->name, (*it)->summary);
@@ -103,6 +105,7 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
     cdl_options_default(&defaults);
     a->pm = defaults.pm;
     a->gkde = defaults.gkde;
+    a->splat = defaults.splat;
     a->integrator = "path";
     a->spp = 0;
     a->width = 512;
@@ -128,6 +131,18 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
             a->scene = o;
             continue;
         }
+        if (cdl_splat_arg_kind(o)) {
+            if (i + 1 >= argc)
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
+            int src = cdl_splat_arg(o, argv[++i], &a->splat, err);
+            if (src)
+                return src;
+            continue;
+        }
+        if (!strcmp(o, "--photons"))
+            a->photons_given = 1;
+        if (!strcmp(o, "--direct"))
+            a->direct_given = 1;
         if (cdl_gkde_arg_kind(o)) {
             if (i + 1 >= argc)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
@@ -391,6 +406,11 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
     opt->single_shadow_rays = a->single_shadow_rays;
     opt->pm = a->pm;
     opt->gkde = a->gkde;
+    opt->splat = a->splat;
+    if (a->photons_given)
+        opt->splat.photons = a->pm.photons;
+    if (a->direct_given)
+        opt->splat.direct_sample = !a->pm.direct_photons;
     if (!rc && a->has_lookat)
         rc = cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
                              cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),

@@ -32,6 +32,8 @@ typedef struct render_args {
     int aov_pathlength, aov_strata;
     cdl_pm_options pm;
     cdl_gkde_options gkde;
+    cdl_splat_options splat;
+    int photons_given, direct_given; /* shared with pm: splat takes them only if given */
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;

@@ -11,10 +11,11 @@ extern const cdl_integrator_vtbl cdl_ir_integrator;
 extern const cdl_integrator_vtbl cdl_rigi_integrator;
 extern const cdl_integrator_vtbl cdl_pm_integrator;
 extern const cdl_integrator_vtbl cdl_gkde_integrator;
+extern const cdl_integrator_vtbl cdl_splat_integrator;
 
 static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
                                                  &cdl_ir_integrator, &cdl_rigi_integrator,
-                                                 &cdl_pm_integrator, &cdl_gkde_integrator, NULL};
+                                                 &cdl_pm_integrator, &cdl_gkde_integrator, &cdl_splat_integrator, NULL};
 
 void cdl_options_default(cdl_options *o)
 {
@@ -37,6 +38,17 @@ void cdl_options_default(cdl_options *o)
     o->gkde.links = 10;
     o->gkde.footprint_cap = 2.0f;
     o->gkde.max_mib = 4096;
+    o->splat.photons = 200000;
+    o->splat.fractions[0] = 0.3f;
+    o->splat.fractions[1] = 0.6f;
+    o->splat.fractions[2] = 0.1f;
+    o->splat.C = 1.0f;
+    o->splat.S = 0.4f;
+    o->splat.R = 0.2f;
+    o->splat.mode = CDL_SPLAT_DIRECT;
+    o->splat.eye_samples = 1;
+    o->splat.cull = 1;
+    o->splat.cap = 4.0f;
 }
 
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)

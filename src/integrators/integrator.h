@@ -53,6 +53,21 @@ typedef struct cdl_gkde_options {
     uint32_t max_mib;    /* cap on the stored path vertices (MiB) */
 } cdl_gkde_options;
 
+/* splat: photon ray splatting (Herzog et al. 2007) */
+typedef enum { CDL_SPLAT_DIRECT, CDL_SPLAT_HISTOGRAM, CDL_SPLAT_SH } cdl_splat_mode;
+
+typedef struct cdl_splat_options {
+    uint32_t photons;    /* photon rays stored per pass, all budgets */
+    float fractions[3];  /* direct, indirect, caustic shares of the budget */
+    float C, S, R;       /* bandwidth smoothness, sensitivity, clamping (§4.2) */
+    int mode;            /* cdl_splat_mode: how the radiance maps hold incident light */
+    int direct_sample;   /* direct light by light sampling instead of direct photons */
+    uint32_t eye_samples; /* eye samples per pixel and pass */
+    int cull;            /* back-face-culling nodes in the eye-sample tree */
+    float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
+                          * test out to c h (spatial/splatkd.h) */
+} cdl_splat_options;
+
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 typedef struct cdl_options {
@@ -76,6 +91,7 @@ typedef struct cdl_options {
 
     cdl_pm_options pm;
     cdl_gkde_options gkde;
+    cdl_splat_options splat;
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the

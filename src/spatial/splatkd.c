@@ -484,8 +484,8 @@ int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int c
         mx = t->parts[part].bmax;
     }
     trav v = {t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, cull, out};
-    /* clip [0, len + h(len)] by the box grown by the largest radius */
-    float hmax = radius_at(r, r->len), t0 = 0.0f, t1 = r->len + hmax;
+    /* clip [0, len + cap h(len)] by the box grown by the largest radius */
+    float hmax = radius_at(r, r->len), t0 = 0.0f, t1 = r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax;
     for (int a = 0; a < 3; a++) {
         float lo = mn[a] - hmax, hi = mx[a] + hmax;
         if (v.d[a] == 0.0f) {

@@ -62,12 +62,23 @@ void cdl_skd_free(cdl_skd *t);
 size_t cdl_skd_bytes(const cdl_skd *t);
 
 /* A photon ray x_{i-1} -> x_i with its bandwidth (§4.2): radius h0 + dh t
- * at distance t along it up to the hit, a hemisphere of radius h(len)
- * beyond it. on: the normal at the origin's front (samples behind the
- * origin surface get nothing); zero for a point light. */
+ * at distance t along it up to the hit, h(len) beyond it. on: the normal
+ * at the origin's front (samples behind the origin surface get nothing);
+ * zero for a point light. Beyond the hit (cap):
+ *   0    the report's hemisphere (Algorithm 2): a sample beyond x_i is fed
+ *        within the sphere of radius h(len) around x_i, the kernel
+ *        renormalized over that sphere's cross-section. Light at angle
+ *        theta onto a plane then reads 1/2 + cos(theta) 8/(3 pi) int_0^1
+ *        (1 - s^2)^(3/2) / (1 - s^2 sin^2(theta))^2 ds of the truth (0.97 at
+ *        34 degrees, 0.89 at 57) whatever h: a bias that never vanishes;
+ *   c>0  a sample is fed if the ray reached its tangent plane before
+ *        ending (so a plane's own samples all are, and a blocker's shadow
+ *        stays dark), out to c h(len) beyond x_i: the irradiance on a plane
+ *        is exact up to incidence atan(c), and the estimate consistent. */
 typedef struct cdl_splat_ray {
     cdl_vec3 o, d, on;
     float len, h0, dh;
+    float cap;
 } cdl_splat_ray;
 
 /* A feasible eye sample: its tree position, kernel times cosine (per unit
@@ -90,7 +101,7 @@ typedef struct cdl_splat_hits {
  * frustum or the hemispherical cap. */
 static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec3 n, uint8_t flags, float *z_out)
 {
-    float c = cdl_dot(r->d, n);
+    float dn = cdl_dot(r->d, n), c = dn;
     if (flags & CDL_SKD_TWO_SIDED)
         c = -fabsf(c);
     if (!(c < 0.0f))
@@ -102,8 +113,16 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
     float h = r->h0 + r->dh * (z < r->len ? z : r->len);
     float h2 = h * h;
     float r2 = cdl_dot(D, D) - z * z;
-    if (z > r->len)
-        h2 -= (z - r->len) * (z - r->len);
+    if (z > r->len) {
+        if (r->cap > 0.0f) {
+            /* the ray must have crossed the sample's tangent plane by its end */
+            float tp = cdl_dot(D, n) / dn;
+            if (z > r->len + r->cap * h || tp > r->len * 1.0001f + 1e-3f * h)
+                return 0.0f;
+        } else {
+            h2 -= (z - r->len) * (z - r->len);
+        }
+    }
     if (!(h2 > 0.0f) || r2 >= h2)
         return 0.0f;
     *z_out = z;

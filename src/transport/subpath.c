@@ -46,13 +46,20 @@ static uint32_t push(cdl_vertex_store *vs)
  * with solid-angle density pdf_dir. */
 static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp, int adjoint,
                         uint32_t prev, cdl_vec3 o, cdl_vec3 d, cdl_vec3 beta, float pdf_dir,
-                        cdl_vertex_store *vs, uint64_t *rays)
+                        cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc)
 {
     for (int depth = 1;; depth++) {
         cdl_hit h;
         (*rays)++;
-        if (!cdl_intersect(s, o, d, FLT_MAX, &h))
+        if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
+            if (esc) {
+                esc->escaped = 1;
+                esc->d = d;
+                esc->beta = beta;
+                esc->pdf_dir = pdf_dir;
+            }
             return;
+        }
         cdl_surface sf;
         cdl_surface_at(s, &h, &sf);
         uint32_t i = push(vs);
@@ -118,7 +125,15 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
 uint32_t cdl_trace_light_subpath(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
                                  cdl_vertex_store *vs, uint64_t *rays)
 {
+    return cdl_trace_light_subpath_esc(s, walk, smp, vs, rays, NULL);
+}
+
+uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
+                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc)
+{
     uint32_t start = vs->n;
+    if (esc)
+        esc->escaped = 0;
     float us, ua, u1, u2, u3, u4, pmf;
     cdl_sampler_2d(smp, &us, &ua);
     uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
@@ -145,7 +160,7 @@ uint32_t cdl_trace_light_subpath(const cdl_scene *s, const cdl_walk *walk, cdl_s
     float cos = cdl_is_black(e.n) ? 1.0f : fabsf(cdl_dot(e.n, e.d));
     cdl_vec3 beta = cdl_scale(e.Le, cos / (pmf * e.pdf_pos * e.pdf_dir));
     cdl_vec3 o = cdl_is_black(e.n) ? e.p : cdl_offset(s, e.p, e.n, e.d);
-    random_walk(s, walk, smp, 1, i, o, e.d, beta, e.pdf_dir, vs, rays);
+    random_walk(s, walk, smp, 1, i, o, e.d, beta, e.pdf_dir, vs, rays, esc);
     return vs->n - start;
 }
 
@@ -166,6 +181,6 @@ uint32_t cdl_trace_eye_subpath(const cdl_scene *s, const cdl_camera *cam, float 
     vs->parent[i] = -1;
     vs->depth[i] = 0;
     vs->flags[i] = CDL_V_CAMERA;
-    random_walk(s, walk, smp, 0, i, cam->eye, d, cdl_v3(1.0f, 1.0f, 1.0f), pdf_dir, vs, rays);
+    random_walk(s, walk, smp, 0, i, cam->eye, d, cdl_v3(1.0f, 1.0f, 1.0f), pdf_dir, vs, rays, NULL);
     return vs->n - start;
 }

@@ -20,6 +20,18 @@ typedef struct cdl_walk {
 uint32_t cdl_trace_light_subpath(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
                                  cdl_vertex_store *vs, uint64_t *rays);
 
+/* How a light subpath left the scene, if it did: the ray from its last
+ * vertex that hit nothing (photon ray splatting splats it too). */
+typedef struct cdl_escape {
+    int escaped;
+    cdl_vec3 d, beta; /* direction, and the power it carries */
+    float pdf_dir;    /* solid-angle density it was sampled with (0: specular) */
+} cdl_escape;
+
+/* The same, telling in esc whether the path ended by leaving the scene. */
+uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
+                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc);
+
 /* Appends an eye subpath through raster point (px, py): x_0 at the camera,
  * then x_1, ... Same room needed; returns the number of vertices. */
 uint32_t cdl_trace_eye_subpath(const cdl_scene *s, const cdl_camera *cam, float px, float py,

@@ -1,0 +1,93 @@
+#include "cli/splat_args.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/args.h"
+
+static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap"};
+
+int cdl_splat_arg_kind(const char *o)
+{
+    for (size_t i = 0; i < sizeof valued / sizeof *valued; i++)
+        if (!strcmp(o, valued[i]))
+            return 1;
+    return 0;
+}
+
+int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error *err)
+{
+    long l;
+    double d;
+    int rc = 0;
+    if (!strcmp(o, "--fractions")) {
+        float f[3];
+        rc = cdl_arg_floats(o, v, 3, f, err);
+        if (!rc && (!(f[0] >= 0.0f && f[1] >= 0.0f && f[2] >= 0.0f) || !(f[0] + f[1] + f[2] > 0.0f)))
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                               "expected three shares d,i,c, none negative, not all zero, got '%s'", v);
+        if (!rc)
+            memcpy(sp->fractions, f, sizeof f);
+    } else if (!strcmp(o, "-C")) {
+        rc = cdl_arg_float(o, v, 1e-4, 1e3, &d, err);
+        sp->C = (float)d;
+    } else if (!strcmp(o, "-S")) {
+        rc = cdl_arg_float(o, v, 0.0, 1.0, &d, err);
+        sp->S = (float)d;
+    } else if (!strcmp(o, "-R")) {
+        rc = cdl_arg_float(o, v, 1e-3, 1.0, &d, err);
+        sp->R = (float)d;
+    } else if (!strcmp(o, "--mode")) {
+        if (!strcmp(v, "direct"))
+            sp->mode = CDL_SPLAT_DIRECT;
+        else if (!strcmp(v, "histogram"))
+            sp->mode = CDL_SPLAT_HISTOGRAM;
+        else if (!strcmp(v, "sh"))
+            sp->mode = CDL_SPLAT_SH;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected direct, histogram or sh, got '%s'", v);
+    } else if (!strcmp(o, "--eye-samples")) {
+        rc = cdl_arg_int(o, v, 1, 1024, &l, err);
+        sp->eye_samples = (uint32_t)l;
+    } else if (!strcmp(o, "--cap")) {
+        if (!strcmp(v, "hemisphere"))
+            sp->cap = 0.0f;
+        else if (!strcmp(v, "plane"))
+            sp->cap = 4.0f;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected plane or hemisphere, got '%s'", v);
+    } else if (!strcmp(o, "--cull-nodes")) {
+        if (!strcmp(v, "on"))
+            sp->cull = 1;
+        else if (!strcmp(v, "off"))
+            sp->cull = 0;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
+    }
+    return rc;
+}
+
+void cdl_splat_args_help(void)
+{
+    printf("Photon ray splatting (splat; Herzog et al. 2007):\n"
+           "      --photons M         photon rays stored per pass, all budgets (default 200000)\n"
+           "      --fractions d,i,c   shares of direct, indirect and caustic rays (default\n"
+           "                          0.3,0.6,0.1)\n"
+           "      -C c                bandwidth smoothness (default 1.0): mean kernel radius\n"
+           "                          C * 0.2 * the mean photon ray length at 10^5 photons\n"
+           "      -S s                bandwidth sensitivity to the path density, 0..1 (default\n"
+           "                          0.4; 0: one bandwidth for all rays)\n"
+           "      -R r                bandwidth clamping, 0..1 (default 0.2): radii within\n"
+           "                          [r, 1/r] times the mean\n"
+           "      --mode KIND         radiance maps: direct (BSDF per splat), histogram (20\n"
+           "                          strata), sh (16 coefficients) (default direct)\n"
+           "      --direct KIND       photons (direct light splatted, default) or sample\n"
+           "                          (light sampling at the eye samples)\n"
+           "      --eye-samples N     eye samples per pixel and pass (default 1)\n"
+           "      --cull-nodes on|off back-face-culling nodes in the eye-sample tree (default on)\n"
+           "      --cap KIND          eye samples beyond a photon ray's hit: plane (fed if the\n"
+           "                          ray reached their tangent plane, out to 4 h: consistent;\n"
+           "                          default) or hemisphere (the report's Algorithm 2: biased\n"
+           "                          low at oblique incidence, whatever h)\n"
+           "\n");
+}

@@ -1,0 +1,304 @@
+/* splat: global illumination by photon ray splatting (Herzog et al. 2007).
+ *
+ * Each pass (§3):
+ *  1. eye pass: --eye-samples jittered camera rays per pixel follow
+ *     specular surfaces (transport/visible.c) to an eye sample: position,
+ *     the normal of the side seen, BSDF, direction to the camera, pixel,
+ *     weight; emission met on the way (and, with --direct sample, light
+ *     sampled at the sample) goes straight to the pixel;
+ *  2. the eye-sample kd-tree (spatial/splatkd.c, §5.1);
+ *  3. light pass: photon rays with path-density bandwidths
+ *     (transport/photon_rays.c, §4.2), the bandwidth's M growing with the
+ *     passes so kernels shrink as M^(-1/6) and the average converges;
+ *  4. every photon ray splats to the eye samples in its frustum
+ *     (Algorithms 1, 2) into the radiance maps (splat_maps.c, §6.1);
+ *  5. the BSDF applied to each sample's map gives the pass's image.
+ * Passes average progressively. Deterministic for a seed on any number of
+ * threads. */
+#include "integrators/splat.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/log.h"
+#include "transport/light_select.h"
+#include "transport/visible.h"
+
+#define PILOT_PATHS 20000
+
+static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
+{
+    splat_state *s = self;
+    s->scene = scene;
+    s->opt = *opt;
+    s->walk.maxdepth = opt->maxdepth;
+    s->walk.rr_depth = opt->rr_depth;
+    const cdl_splat_options *o = &opt->splat;
+    if (!scene->nlights)
+        return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "the scene has no lights: nothing to render");
+    float fsum = o->fractions[0] + o->fractions[1] + o->fractions[2];
+    if (!(fsum > 0.0f))
+        return cdl_error_set(err, CDL_ERR_USAGE, "--fractions", 0, "at least one share must be positive");
+    for (int c = 0; c < CDL_PRAY_CATS; c++) {
+        float f = o->fractions[c] / fsum;
+        if (c == CDL_PRAY_DIRECT && o->direct_sample)
+            f = 0.0f;
+        s->pp.target[c] = (uint32_t)lrint((double)f * o->photons);
+    }
+    if (!s->pp.target[0] && !s->pp.target[1] && !s->pp.target[2])
+        return cdl_error_set(err, CDL_ERR_USAGE, "--fractions", 0,
+                             "no photon budget left (with --direct sample the direct share is unused)");
+    s->pp.C = o->C;
+    s->pp.S = o->S;
+    s->pp.R = o->R;
+    float diag = cdl_length(cdl_sub(scene->bmax, scene->bmin));
+    float dt = 0.01f * diag; /* D~: 1 % of the scene's diagonal */
+    s->pp.d2_clamp = dt * dt;
+    s->pp.max_paths = (uint64_t)o->photons * 100u > (1u << 20) ? (uint64_t)o->photons * 100u : (1u << 20);
+    cdl_skd_params_default(&s->kp, diag);
+    s->kp.part_depth = 4;
+    if (!o->cull)
+        s->kp.cull_deg = -1.0f;
+    size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;
+    s->nslots = (uint32_t)(npix * o->eye_samples);
+    s->base = calloc(npix, sizeof *s->base);
+    s->pix = calloc(npix, sizeof *s->pix);
+    s->slot = malloc(sizeof *s->slot * s->nslots);
+    s->sp = malloc(sizeof *s->sp * s->nslots);
+    s->sn = malloc(sizeof *s->sn * s->nslots);
+    s->sflags = malloc(s->nslots);
+    s->svalid = malloc(s->nslots);
+    if (!s->base || !s->pix || !s->slot || !s->sp || !s->sn || !s->sflags || !s->svalid)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for %u eye samples", s->nslots);
+    return splat_maps_init(s, err);
+}
+
+/* Step 1 for pixel row y: its eye samples into their slots. */
+static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *dc, cdl_lcon_scratch *lc,
+                    uint64_t *rays)
+{
+    const cdl_camera *cam = &s->opt.camera;
+    const cdl_scene *sc = s->scene;
+    uint32_t E = s->opt.splat.eye_samples;
+    for (int x = 0; x < cam->width; x++) {
+        uint32_t p = (uint32_t)y * (uint32_t)cam->width + (uint32_t)x;
+        cdl_vec3 base = cdl_v3(0.0f, 0.0f, 0.0f);
+        for (uint32_t j = 0; j < E; j++) {
+            uint32_t k = p * E + j;
+            s->svalid[k] = 0;
+            cdl_sampler smp;
+            float jx, jy;
+            cdl_sampler_start(&smp, s->opt.sampler, s->opt.seed, k, pass);
+            cdl_sampler_2d(&smp, &jx, &jy);
+            cdl_visible v;
+            int hit = cdl_find_visible(sc, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
+                                       s->opt.maxdepth, &smp, rays, &v);
+            base = cdl_add(base, v.L);
+            if (!hit)
+                continue;
+            if (s->opt.splat.direct_sample) {
+                uint32_t nl = 0;
+                cdl_vec3 Ld = cdl_direct_light(sc, dc, lc, &v.sf, &v.b, v.wo, &smp, rays, &nl);
+                base = cdl_add(base, cdl_mul(v.beta, Ld));
+            }
+            splat_eye *e = &s->slot[k];
+            e->b = v.b;
+            e->weight = cdl_scale(v.beta, 1.0f / (float)E);
+            e->wo = v.wo;
+            e->pixel = p;
+            e->mat = v.sf.mat;
+            e->lambert = v.b.type == CDL_MAT_DIFFUSE;
+            cdl_vec3 ng = cdl_dot(v.sf.ng, v.wo) < 0.0f ? cdl_neg(v.sf.ng) : v.sf.ng;
+            cdl_vec3 n = v.b.frame.n;
+            if (cdl_dot(n, v.wo) < 0.0f)
+                n = cdl_neg(n);
+            cdl_vec3 t = cdl_sub(v.wo, cdl_scale(n, cdl_dot(v.wo, n)));
+            float tl = cdl_length(t);
+            cdl_frame f = cdl_frame_from(n);
+            if (tl > 1e-6f) {
+                f.t = cdl_scale(t, 1.0f / tl);
+                f.b = cdl_cross(n, f.t);
+            }
+            e->f = f;
+            s->sp[k] = v.sf.p;
+            s->sn[k] = ng;
+            s->sflags[k] = v.b.type == CDL_MAT_ROUGH_DIELECTRIC ? CDL_SKD_TWO_SIDED : 0;
+            s->svalid[k] = 1;
+        }
+        s->base[p] = cdl_scale(base, 1.0f / (float)E);
+    }
+}
+
+static int eye_pass(splat_state *s, uint32_t pass, uint64_t *rays, cdl_error *err)
+{
+    const cdl_camera *cam = &s->opt.camera;
+    uint64_t r = 0;
+    int fail = 0;
+#pragma omp parallel reduction(+ : r)
+    {
+        cdl_lcon_scratch lc;
+        int ok = cdl_lcon_scratch_init(&lc, s->scene->nlights) == 0;
+        cdl_direct_cfg dc = {CDL_DIRECT_POWER, 1, NULL, 0.0f};
+#pragma omp for schedule(dynamic, 4)
+        for (int y = 0; y < cam->height; y++)
+            if (ok)
+                eye_row(s, y, pass, &dc, &lc, &r);
+        if (!ok) {
+#pragma omp atomic write
+            fail = 1;
+        }
+        if (ok)
+            cdl_lcon_scratch_free(&lc);
+    }
+    *rays += r;
+    if (fail)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory");
+    /* the valid slots, in slot order, become the eye samples */
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < s->nslots; k++)
+        if (s->svalid[k]) {
+            s->slot[n] = s->slot[k];
+            s->sp[n] = s->sp[k];
+            s->sn[n] = s->sn[k];
+            s->sflags[n] = s->sflags[k];
+            n++;
+        }
+    s->neye = n;
+    return 0;
+}
+
+/* Step 2: the tree, the samples moved into its order, the maps sized. */
+static int build(splat_state *s, cdl_error *err)
+{
+    cdl_skd_free(&s->tree);
+    if (cdl_skd_build(&s->tree, s->sp, s->sn, s->sflags, s->neye, &s->kp, err))
+        return err->code;
+    if (!s->eye) {
+        s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1));
+        s->map = malloc(sizeof(float) * 3 * s->K * (s->nslots ? s->nslots : 1));
+        s->splat_img = malloc(sizeof(float) * 2 * (s->nslots ? s->nslots : 1));
+        if (!s->eye || !s->map || !s->splat_img)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
+    }
+    for (uint32_t q = 0; q < s->neye; q++)
+        s->eye[q] = s->slot[s->tree.order[q]];
+    return 0;
+}
+
+static size_t bytes(const splat_state *s)
+{
+    return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2 + (3 * s->K + 2) * sizeof(float)) +
+           cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
+           (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
+}
+
+static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+{
+    splat_state *s = self;
+    double t0 = cdl_time_now();
+    int rc = eye_pass(s, pass, &film->rays, err);
+    double t1 = cdl_time_now();
+    s->st.t_ray += t1 - t0;
+    if (!rc)
+        rc = build(s, err);
+    double t2 = cdl_time_now();
+    s->st.t_build += t2 - t1;
+    if (rc || cdl_cancel)
+        return rc;
+    if (!s->have_pilot) {
+        rc = cdl_pray_pilot(s->scene, &s->walk, s->opt.sampler, s->opt.seed, PILOT_PATHS, s->pp.S, s->pp.d2_clamp,
+                            &s->pp.w, &s->pp.mu, err);
+        if (rc)
+            return rc;
+        s->have_pilot = 1;
+    }
+    s->pp.m_scale = (double)pass + 1.0;
+    rc = cdl_pray_trace(s->scene, &s->walk, &s->pp, s->opt.sampler, s->opt.seed, pass, &s->rays, err);
+    if (rc)
+        return rc;
+    film->rays += s->rays.rays;
+    s->st.rays_stored += s->rays.n;
+    double t3 = cdl_time_now();
+    s->st.t_light += t3 - t2;
+    rc = splat_maps_splat(s, err);
+    double t4 = cdl_time_now();
+    s->st.t_solve += t4 - t3;
+    if (rc || cdl_cancel)
+        return rc; /* an interrupted pass adds nothing */
+    const cdl_camera *cam = &s->opt.camera;
+    size_t npix = (size_t)cam->width * (size_t)cam->height;
+    memset(s->pix, 0, sizeof *s->pix * npix);
+    splat_maps_resolve(s);
+    uint64_t bad = 0;
+    for (size_t p = 0; p < npix; p++)
+        bad += (uint64_t)cdl_film_add(film, (int)(p % (size_t)cam->width), (int)(p / (size_t)cam->width),
+                                      cdl_add(s->base[p], s->pix[p]));
+    film->nonfinite += bad;
+    double t5 = cdl_time_now();
+    s->st.t_brdf += t5 - t4;
+    s->st.samples += s->neye;
+    s->st.passes++;
+    s->st.t_total += t5 - t0;
+    size_t b = bytes(s);
+    if (b > s->st.peak_bytes)
+        s->st.peak_bytes = b;
+    return 0;
+}
+
+static const char *mode_name(int m)
+{
+    return m == CDL_SPLAT_HISTOGRAM ? "histogram" : m == CDL_SPLAT_SH ? "sh" : "direct";
+}
+
+static void splat_report(const void *self)
+{
+    const splat_state *s = self;
+    const splat_stats *t = &s->st;
+    if (cdl_log_quiet || !t->passes)
+        return;
+    double P = (double)t->passes;
+    printf("splat: mode %s, %.0f photon rays per pass (budgets %u/%u/%u, paths %llu/%llu/%llu in the last), "
+           "C %.2g S %.2g R %.2g, mean bandwidth scale mu_C %.4g; %.0f eye samples per pass, %.1f splats per "
+           "photon ray, %.2f samples tested per splat; memory %.1f MiB (peak)\n",
+           mode_name(s->opt.splat.mode), (double)t->rays_stored / P, s->pp.target[0], s->pp.target[1],
+           s->pp.target[2], (unsigned long long)s->rays.paths[0], (unsigned long long)s->rays.paths[1],
+           (unsigned long long)s->rays.paths[2], (double)s->pp.C, (double)s->pp.S, (double)s->pp.R, (double)s->pp.mu,
+           (double)t->samples / P, t->rays_stored ? (double)t->splats / (double)t->rays_stored : 0.0,
+           t->splats ? (double)t->tested / (double)t->splats : 0.0, (double)t->peak_bytes / 1048576.0);
+    printf("splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_brdf %.2f "
+           "(eye-sample tree: %u nodes, %u leaves, %u culling, %u empty, depth %u)\n",
+           (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_brdf,
+           s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
+}
+
+static void splat_destroy(void *self)
+{
+    splat_state *s = self;
+    cdl_pray_free(&s->rays);
+    cdl_skd_free(&s->tree);
+    free(s->sp);
+    free(s->sn);
+    free(s->sflags);
+    free(s->svalid);
+    free(s->slot);
+    free(s->eye);
+    free(s->base);
+    free(s->pix);
+    free(s->map);
+    free(s->splat_img);
+    free(s->tables);
+}
+
+const cdl_integrator_vtbl cdl_splat_integrator = {
+    .name = "splat",
+    .summary = "photon ray splatting (Herzog et al. 2007): photon rays with path-density bandwidths splatted to "
+               "eye samples through a kd-tree, radiance maps direct | histogram | SH",
+    .prepare = splat_prepare,
+    .render_pass = splat_render_pass,
+    .destroy = splat_destroy,
+    .report = splat_report,
+    .self_size = sizeof(splat_state),
+};

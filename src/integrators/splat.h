@@ -1,0 +1,65 @@
+/* The state of the splat integrator (Herzog et al. 2007), shared by its
+ * halves: splat.c (eye pass, photon rays, the pass, the report) and
+ * splat_maps.c (radiance maps: what a splat adds, and the BSDF applied at
+ * the end). Eye samples live in the eye-sample tree's order. */
+#ifndef CDL_INTEGRATORS_SPLAT_H
+#define CDL_INTEGRATORS_SPLAT_H
+
+#include "core/sh.h"
+#include "integrators/integrator.h"
+#include "scene/bsdf_sh.h"
+#include "spatial/splatkd.h"
+#include "transport/photon_rays.h"
+
+#define SPLAT_STRATA 20 /* icosahedron faces */
+
+/* An eye sample (§3): what the final step needs besides the tree's
+ * position and normal. */
+typedef struct splat_eye {
+    cdl_bsdf b;
+    cdl_vec3 weight; /* the specular chain's weight / eye samples per pixel */
+    cdl_vec3 wo;     /* towards the camera */
+    cdl_frame f;     /* shading normal on the seen side; t towards wo (SH tables) */
+    uint32_t pixel, mat;
+    uint8_t lambert; /* a diffuse BSDF: f = kd / pi */
+} splat_eye;
+
+typedef struct splat_stats {
+    double t_ray, t_light, t_build, t_solve, t_brdf, t_total;
+    uint64_t rays_stored, splats, tested, nodes, samples, passes;
+    size_t peak_bytes;
+} splat_stats;
+
+typedef struct splat_state {
+    const cdl_scene *scene;
+    cdl_options opt;
+    cdl_walk walk;
+    cdl_pray_params pp;
+    int have_pilot;
+    cdl_pray_set rays;
+    /* eye samples: slots per pixel sample while tracing, then tree order */
+    cdl_vec3 *sp, *sn;
+    uint8_t *sflags, *svalid;
+    splat_eye *slot, *eye;
+    uint32_t nslots, neye;
+    cdl_vec3 *base;   /* per pixel: emission seen and direct light sampled, this pass */
+    cdl_vec3 *pix;    /* per pixel: this pass's image */
+    cdl_skd tree;
+    cdl_skd_params kp;
+    float *map;       /* per eye sample: K x 3 floats */
+    uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
+    float *splat_img; /* per eye sample: kernel weight sum, sum of 1 / z (for filtering and caching) */
+    cdl_vec3 strata[SPLAT_STRATA];
+    cdl_sh_rot rot;
+    cdl_bsdf_sh *tables; /* per material (SH mode) */
+    splat_stats st;
+} splat_state;
+
+/* Radiance-map setup of the mode (strata, SH tables); 0 or an error. */
+int splat_maps_init(splat_state *s, cdl_error *err);
+/* Splats every photon ray into the maps, part by part on all threads. */
+int splat_maps_splat(splat_state *s, cdl_error *err);
+/* Each eye sample's reflected radiance, weighted, into s->pix. */
+void splat_maps_resolve(splat_state *s);
+
+#endif

@@ -1,0 +1,226 @@
+/* splat's radiance maps (Herzog et al. 2007, §6.1): per eye sample, the
+ * light its photon splats bring, in one of three forms:
+ *   direct     the BSDF applied per splat (exact, the cost grows with the
+ *              splats on glossy samples),
+ *   histogram  irradiance per icosahedron face of incoming directions (20
+ *              strata in world space), the BSDF applied once per stratum at
+ *              its centre at the end,
+ *   sh         the 16 spherical-harmonics coefficients of L cos in world
+ *              space (the basis evaluated once per photon ray), rotated to
+ *              the sample's frame at the end and dotted with the material's
+ *              BSDF table (eq. 6.3, 6.4).
+ * Splatting runs part by part of the eye-sample tree, each part on one
+ * thread meeting the rays in their order: the maps do not depend on the
+ * thread count. */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrators/splat.h"
+
+/* The 20 face centres of an icosahedron. */
+static void icosahedron(cdl_vec3 *c)
+{
+    const float g = 1.6180339887f;
+    cdl_vec3 v[12];
+    int n = 0;
+    for (int s1 = -1; s1 <= 1; s1 += 2)
+        for (int s2 = -1; s2 <= 1; s2 += 2) {
+            v[n++] = cdl_v3(0.0f, (float)s1, (float)s2 * g);
+            v[n++] = cdl_v3((float)s1, (float)s2 * g, 0.0f);
+            v[n++] = cdl_v3((float)s2 * g, 0.0f, (float)s1);
+        }
+    int f = 0;
+    for (int i = 0; i < 12; i++)
+        for (int j = i + 1; j < 12; j++)
+            for (int k = j + 1; k < 12; k++) {
+                cdl_vec3 a = cdl_sub(v[i], v[j]), b = cdl_sub(v[j], v[k]), d = cdl_sub(v[i], v[k]);
+                if (fabsf(cdl_dot(a, a) - 4.0f) < 1e-3f && fabsf(cdl_dot(b, b) - 4.0f) < 1e-3f &&
+                    fabsf(cdl_dot(d, d) - 4.0f) < 1e-3f && f < SPLAT_STRATA)
+                    c[f++] = cdl_normalize(cdl_add(cdl_add(v[i], v[j]), v[k]));
+            }
+}
+
+static int stratum(const splat_state *s, cdl_vec3 w)
+{
+    int best = 0;
+    float bd = -2.0f;
+    for (int i = 0; i < SPLAT_STRATA; i++) {
+        float d = cdl_dot(w, s->strata[i]);
+        if (d > bd) {
+            bd = d;
+            best = i;
+        }
+    }
+    return best;
+}
+
+int splat_maps_init(splat_state *s, cdl_error *err)
+{
+    s->K = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? SPLAT_STRATA : s->opt.splat.mode == CDL_SPLAT_SH ? CDL_SH_N : 1;
+    icosahedron(s->strata);
+    if (s->opt.splat.mode != CDL_SPLAT_SH)
+        return 0;
+    if (cdl_sh_rot_init(&s->rot))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "spherical-harmonics rotation is ill-conditioned");
+    const cdl_scene *sc = s->scene;
+    s->tables = malloc(sizeof *s->tables * (sc->nmats ? sc->nmats : 1));
+    if (!s->tables)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the BSDF tables");
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t m = 0; m < (int64_t)sc->nmats; m++)
+        if (!cdl_mat_is_delta(sc->mats[m].type))
+            cdl_bsdf_sh_build(&s->tables[m], &sc->mats[m]);
+    return 0;
+}
+
+/* What one ray adds per unit of kernel weight (RGB per stratum or
+ * coefficient), computed once per ray and part. */
+typedef struct ray_terms {
+    float sh[CDL_SH_N * 3];
+    int stratum;
+    cdl_vec3 wi; /* towards the light */
+} ray_terms;
+
+static void splat_hits(splat_state *s, const cdl_photon_ray *r, const cdl_splat_hits *h)
+{
+    const int mode = s->opt.splat.mode;
+    ray_terms t;
+    t.stratum = 0;
+    t.wi = cdl_neg(r->d);
+    if (mode == CDL_SPLAT_SH) {
+        float y[CDL_SH_N];
+        cdl_sh_eval(t.wi, y);
+        for (int k = 0; k < CDL_SH_N; k++) {
+            t.sh[k * 3] = y[k] * r->flux.x;
+            t.sh[k * 3 + 1] = y[k] * r->flux.y;
+            t.sh[k * 3 + 2] = y[k] * r->flux.z;
+        }
+    } else if (mode == CDL_SPLAT_HISTOGRAM) {
+        t.stratum = stratum(s, t.wi);
+    }
+    for (uint32_t i = 0; i < h->n; i++) {
+        uint32_t q = h->h[i].s;
+        float w = h->h[i].w;
+        float *m = &s->map[(size_t)q * s->K * 3];
+        if (mode == CDL_SPLAT_SH) {
+            for (int k = 0; k < CDL_SH_N * 3; k++)
+                m[k] += w * t.sh[k];
+        } else if (mode == CDL_SPLAT_HISTOGRAM) {
+            float *e = &m[t.stratum * 3];
+            e[0] += w * r->flux.x;
+            e[1] += w * r->flux.y;
+            e[2] += w * r->flux.z;
+        } else {
+            const splat_eye *ey = &s->eye[q];
+            cdl_vec3 f = ey->lambert ? cdl_scale(ey->b.kd, (float)CDL_INV_PI) : cdl_bsdf_eval(&ey->b, ey->wo, t.wi, 0);
+            m[0] += w * f.x * r->flux.x;
+            m[1] += w * f.y * r->flux.y;
+            m[2] += w * f.z * r->flux.z;
+        }
+        float *si = &s->splat_img[(size_t)q * 2];
+        si[0] += w;
+        si[1] += h->h[i].z > 0.0f ? 1.0f / h->h[i].z : 0.0f;
+    }
+}
+
+int splat_maps_splat(splat_state *s, cdl_error *err)
+{
+    size_t n = (size_t)s->neye * s->K * 3;
+    memset(s->map, 0, sizeof(float) * (n ? n : 1));
+    memset(s->splat_img, 0, sizeof(float) * 2 * (s->neye ? s->neye : 1));
+    uint64_t splats = 0, tested = 0, nodes = 0;
+    int fail = 0;
+#pragma omp parallel reduction(+ : splats, tested, nodes)
+    {
+        cdl_splat_hits h = {0};
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t part = 0; part < s->tree.nparts; part++) {
+            for (uint32_t k = 0; k < s->rays.n && !cdl_cancel && !h.fail; k++) {
+                const cdl_photon_ray *r = &s->rays.r[k];
+                cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+                h.n = 0;
+                if (cdl_skd_splat(&s->tree, part, &sr, s->opt.splat.cull, &h))
+                    break;
+                if (h.n) {
+                    splat_hits(s, r, &h);
+                    splats += h.n;
+                }
+            }
+        }
+        tested += h.tested;
+        nodes += h.nodes;
+        if (h.fail) {
+#pragma omp atomic write
+            fail = 1;
+        }
+        free(h.h);
+    }
+    s->st.splats += splats;
+    s->st.tested += tested;
+    s->st.nodes += nodes;
+    if (fail)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the splat candidates");
+    return 0;
+}
+
+/* The stratum's centre, moved just above the horizon of n if it lies
+ * below: the photons counted there all arrived from above. */
+static cdl_vec3 above(cdl_vec3 w, cdl_vec3 n)
+{
+    float c = cdl_dot(w, n);
+    if (c > 0.05f)
+        return w;
+    return cdl_normalize(cdl_add(w, cdl_scale(n, 0.05f - c)));
+}
+
+void splat_maps_resolve(splat_state *s)
+{
+    const int mode = s->opt.splat.mode;
+#pragma omp parallel for schedule(static)
+    for (uint32_t q = 0; q < s->neye; q++) {
+        const splat_eye *e = &s->eye[q];
+        const float *m = &s->map[(size_t)q * s->K * 3];
+        cdl_vec3 L;
+        if (mode == CDL_SPLAT_DIRECT) {
+            L = cdl_v3(m[0], m[1], m[2]);
+        } else if (mode == CDL_SPLAT_HISTOGRAM) {
+            cdl_vec3 E = cdl_v3(0.0f, 0.0f, 0.0f);
+            L = E;
+            for (int k = 0; k < SPLAT_STRATA; k++) {
+                cdl_vec3 Ek = cdl_v3(m[k * 3], m[k * 3 + 1], m[k * 3 + 2]);
+                if (cdl_is_black(Ek))
+                    continue;
+                if (e->lambert) {
+                    E = cdl_add(E, Ek);
+                    continue;
+                }
+                cdl_vec3 wi = above(s->strata[k], e->f.n);
+                L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&e->b, e->wo, wi, 0), Ek));
+            }
+            if (e->lambert)
+                L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), E);
+        } else {
+            float loc[CDL_SH_N * 3], c[CDL_SH_N * 3];
+            cdl_sh_rotate(&s->rot, e->f, m, loc, 3);
+            cdl_bsdf_sh_lookup(&s->tables[e->mat], cdl_dot(e->wo, e->f.n), e->b.kd, c);
+            float acc[3] = {0.0f, 0.0f, 0.0f};
+            for (int k = 0; k < CDL_SH_N; k++)
+                for (int ch = 0; ch < 3; ch++)
+                    acc[ch] += c[k * 3 + ch] * loc[k * 3 + ch];
+            L = cdl_v3(fmaxf(acc[0], 0.0f), fmaxf(acc[1], 0.0f), fmaxf(acc[2], 0.0f));
+        }
+        L = cdl_mul(L, e->weight);
+        /* pixels take their samples in tree order: one pixel's samples may
+         * sit in different parts, so this sum runs after the parallel loop */
+        s->map[(size_t)q * s->K * 3] = L.x;
+        s->map[(size_t)q * s->K * 3 + 1] = L.y;
+        s->map[(size_t)q * s->K * 3 + 2] = L.z;
+    }
+    for (uint32_t q = 0; q < s->neye; q++) {
+        const float *m = &s->map[(size_t)q * s->K * 3];
+        uint32_t p = s->eye[q].pixel;
+        s->pix[p] = cdl_add(s->pix[p], cdl_v3(m[0], m[1], m[2]));
+    }
+}
