@@ -37,6 +37,11 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     s->walk.maxdepth = opt->maxdepth;
     s->walk.rr_depth = opt->rr_depth;
     const cdl_splat_options *o = &opt->splat;
+    if (opt->light_paths)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
+                             "splat traces photon paths until its budgets are full: use --photons");
+    if (opt->interleave > 1)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "splat does not interleave light paths");
     if (!scene->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "the scene has no lights: nothing to render");
     float fsum = o->fractions[0] + o->fractions[1] + o->fractions[2];

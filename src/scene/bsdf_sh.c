@@ -56,6 +56,14 @@ static void project(const cdl_bsdf *b, cdl_vec3 wo, double acc[CDL_SH_N][3])
 
 void cdl_bsdf_sh_build(cdl_bsdf_sh *t, const cdl_material *m)
 {
+    if (m->type == CDL_MAT_DIFFUSE) {
+        /* kd / pi everywhere: c_00 = kd / pi sqrt(4 pi), exactly */
+        memset(t, 0, sizeof *t);
+        for (int i = 0; i < CDL_BSDF_SH_BINS; i++)
+            for (int ch = 0; ch < 3; ch++)
+                t->dc[i][0][ch] = (float)(2.0 / sqrt(CDL_PI));
+        return;
+    }
     cdl_vec3 n = cdl_v3(0.0f, 0.0f, 1.0f);
     cdl_bsdf b0, b1;
     cdl_bsdf_init(&b0, m, cdl_v3(0.0f, 0.0f, 0.0f), n, n);
