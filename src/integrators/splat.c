@@ -47,8 +47,18 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     float fsum = o->fractions[0] + o->fractions[1] + o->fractions[2];
     if (!(fsum > 0.0f))
         return cdl_error_set(err, CDL_ERR_USAGE, "--fractions", 0, "at least one share must be positive");
+    /* a scene without specular surfaces has no caustic rays: that share
+     * goes to the indirect budget instead of tracing paths in vain */
+    int specular = 0;
+    for (uint32_t m = 0; m < scene->nmats; m++)
+        specular |= cdl_mat_is_delta(scene->mats[m].type);
+    float share[CDL_PRAY_CATS] = {o->fractions[0], o->fractions[1], o->fractions[2]};
+    if (!specular) {
+        share[CDL_PRAY_INDIRECT] += share[CDL_PRAY_CAUSTIC];
+        share[CDL_PRAY_CAUSTIC] = 0.0f;
+    }
     for (int c = 0; c < CDL_PRAY_CATS; c++) {
-        float f = o->fractions[c] / fsum;
+        float f = share[c] / fsum;
         if (c == CDL_PRAY_DIRECT && o->direct_sample)
             f = 0.0f;
         s->pp.target[c] = (uint32_t)lrint((double)f * o->photons);
@@ -267,12 +277,13 @@ static void splat_report(const void *self)
     double P = (double)t->passes;
     printf("splat: mode %s, %.0f photon rays per pass (budgets %u/%u/%u, paths %llu/%llu/%llu in the last), "
            "C %.2g S %.2g R %.2g, mean bandwidth scale mu_C %.4g; %.0f eye samples per pass, %.1f splats per "
-           "photon ray, %.2f samples tested per splat; memory %.1f MiB (peak)\n",
+           "photon ray, %.2f samples tested per splat, %.0f nodes visited per ray; memory %.1f MiB (peak)\n",
            mode_name(s->opt.splat.mode), (double)t->rays_stored / P, s->pp.target[0], s->pp.target[1],
            s->pp.target[2], (unsigned long long)s->rays.paths[0], (unsigned long long)s->rays.paths[1],
            (unsigned long long)s->rays.paths[2], (double)s->pp.C, (double)s->pp.S, (double)s->pp.R, (double)s->pp.mu,
            (double)t->samples / P, t->rays_stored ? (double)t->splats / (double)t->rays_stored : 0.0,
-           t->splats ? (double)t->tested / (double)t->splats : 0.0, (double)t->peak_bytes / 1048576.0);
+           t->splats ? (double)t->tested / (double)t->splats : 0.0,
+           t->rays_stored ? (double)t->nodes / (double)t->rays_stored : 0.0, (double)t->peak_bytes / 1048576.0);
     printf("splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_brdf %.2f "
            "(eye-sample tree: %u nodes, %u leaves, %u culling, %u empty, depth %u)\n",
            (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_brdf,

@@ -75,93 +75,99 @@ int splat_maps_init(splat_state *s, cdl_error *err)
     return 0;
 }
 
-/* What one ray adds per unit of kernel weight (RGB per stratum or
- * coefficient), computed once per ray and part. */
-typedef struct ray_terms {
+/* What one ray adds per unit of kernel weight, computed once per ray and
+ * part: RGB per SH coefficient, or the ray's stratum. */
+typedef struct ray_ctx {
+    splat_state *s;
+    const cdl_photon_ray *r;
     float sh[CDL_SH_N * 3];
-    int stratum;
+    int stratum, ready;
     cdl_vec3 wi; /* towards the light */
-} ray_terms;
+    uint64_t splats;
+} ray_ctx;
 
-static void splat_hits(splat_state *s, const cdl_photon_ray *r, const cdl_splat_hits *h)
+static void ray_terms(ray_ctx *c)
 {
-    const int mode = s->opt.splat.mode;
-    ray_terms t;
-    t.stratum = 0;
-    t.wi = cdl_neg(r->d);
-    if (mode == CDL_SPLAT_SH) {
+    const cdl_photon_ray *r = c->r;
+    c->wi = cdl_neg(r->d);
+    c->ready = 1;
+    if (c->s->opt.splat.mode == CDL_SPLAT_SH) {
         float y[CDL_SH_N];
-        cdl_sh_eval(t.wi, y);
+        cdl_sh_eval(c->wi, y);
         for (int k = 0; k < CDL_SH_N; k++) {
-            t.sh[k * 3] = y[k] * r->flux.x;
-            t.sh[k * 3 + 1] = y[k] * r->flux.y;
-            t.sh[k * 3 + 2] = y[k] * r->flux.z;
+            c->sh[k * 3] = y[k] * r->flux.x;
+            c->sh[k * 3 + 1] = y[k] * r->flux.y;
+            c->sh[k * 3 + 2] = y[k] * r->flux.z;
         }
-    } else if (mode == CDL_SPLAT_HISTOGRAM) {
-        t.stratum = stratum(s, t.wi);
+    } else if (c->s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) {
+        c->stratum = stratum(c->s, c->wi);
     }
-    for (uint32_t i = 0; i < h->n; i++) {
-        uint32_t q = h->h[i].s;
-        float w = h->h[i].w;
-        float *m = &s->map[(size_t)q * s->K * 3];
+}
+
+/* A batch of samples from the tree: the feasible ones get the ray's light. */
+static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *z)
+{
+    ray_ctx *c = ctx;
+    splat_state *s = c->s;
+    if (!c->ready)
+        ray_terms(c);
+    const int mode = s->opt.splat.mode;
+    const uint32_t K3 = s->K * 3;
+    const cdl_vec3 flux = c->r->flux;
+    for (uint32_t i = 0; i < m; i++) {
+        if (!(w[i] > 0.0f))
+            continue;
+        uint32_t q = first + i;
+        float wi = w[i], *mp = &s->map[(size_t)q * K3];
+        c->splats++;
         if (mode == CDL_SPLAT_SH) {
             for (int k = 0; k < CDL_SH_N * 3; k++)
-                m[k] += w * t.sh[k];
+                mp[k] += wi * c->sh[k];
         } else if (mode == CDL_SPLAT_HISTOGRAM) {
-            float *e = &m[t.stratum * 3];
-            e[0] += w * r->flux.x;
-            e[1] += w * r->flux.y;
-            e[2] += w * r->flux.z;
+            float *e = &mp[c->stratum * 3];
+            e[0] += wi * flux.x;
+            e[1] += wi * flux.y;
+            e[2] += wi * flux.z;
         } else {
             const splat_eye *ey = &s->eye[q];
-            cdl_vec3 f = ey->lambert ? cdl_scale(ey->b.kd, (float)CDL_INV_PI) : cdl_bsdf_eval(&ey->b, ey->wo, t.wi, 0);
-            m[0] += w * f.x * r->flux.x;
-            m[1] += w * f.y * r->flux.y;
-            m[2] += w * f.z * r->flux.z;
+            cdl_vec3 f = ey->lambert ? cdl_scale(ey->b.kd, (float)CDL_INV_PI) : cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
+            mp[0] += wi * f.x * flux.x;
+            mp[1] += wi * f.y * flux.y;
+            mp[2] += wi * f.z * flux.z;
         }
         float *si = &s->splat_img[(size_t)q * 2];
-        si[0] += w;
-        si[1] += h->h[i].z > 0.0f ? 1.0f / h->h[i].z : 0.0f;
+        si[0] += wi;
+        si[1] += z[i] > 0.0f ? 1.0f / z[i] : 0.0f;
     }
 }
 
 int splat_maps_splat(splat_state *s, cdl_error *err)
 {
+    (void)err;
     size_t n = (size_t)s->neye * s->K * 3;
     memset(s->map, 0, sizeof(float) * (n ? n : 1));
     memset(s->splat_img, 0, sizeof(float) * 2 * (s->neye ? s->neye : 1));
     uint64_t splats = 0, tested = 0, nodes = 0;
-    int fail = 0;
-#pragma omp parallel reduction(+ : splats, tested, nodes)
-    {
-        cdl_splat_hits h = {0};
-#pragma omp for schedule(dynamic, 1)
-        for (uint32_t part = 0; part < s->tree.nparts; part++) {
-            for (uint32_t k = 0; k < s->rays.n && !cdl_cancel && !h.fail; k++) {
-                const cdl_photon_ray *r = &s->rays.r[k];
-                cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
-                h.n = 0;
-                if (cdl_skd_splat(&s->tree, part, &sr, s->opt.splat.cull, &h))
-                    break;
-                if (h.n) {
-                    splat_hits(s, r, &h);
-                    splats += h.n;
-                }
-            }
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
+    for (uint32_t part = 0; part < s->tree.nparts; part++) {
+        cdl_skd_count cnt = {0, 0};
+        ray_ctx c;
+        c.s = s;
+        c.splats = 0;
+        for (uint32_t k = 0; k < s->rays.n && !cdl_cancel; k++) {
+            const cdl_photon_ray *r = &s->rays.r[k];
+            cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+            c.r = r;
+            c.ready = 0;
+            cdl_skd_splat_visit(&s->tree, part, &sr, s->opt.splat.cull, splat_batch, &c, &cnt);
         }
-        tested += h.tested;
-        nodes += h.nodes;
-        if (h.fail) {
-#pragma omp atomic write
-            fail = 1;
-        }
-        free(h.h);
+        splats += c.splats;
+        tested += cnt.tested;
+        nodes += cnt.nodes;
     }
     s->st.splats += splats;
     s->st.tested += tested;
     s->st.nodes += nodes;
-    if (fail)
-        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the splat candidates");
     return 0;
 }
 

@@ -39,6 +39,7 @@ typedef struct cdl_skd {
     uint32_t *order; /* caller's index of the sample at each tree position */
     float *p[3], *nrm[3];
     uint8_t *flags;
+    float *two; /* 1 for a two-sided sample, else 0 (the leaf test's arithmetic) */
     float bmin[3], bmax[3];
     cdl_skd_part *parts;
     uint32_t nparts;
@@ -129,10 +130,20 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
     return (float)(2.0 / CDL_PI) / h2 * (1.0f - (r2 > 0.0f ? r2 : 0.0f) / h2) * -c;
 }
 
-/* Appends the feasible samples of part `part` (UINT32_MAX: the whole tree)
- * to out, traversing with the frustum. Returns 0, or -1 out of memory. */
+/* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
+ * by traversing with the frustum, in batches: samples [first, first + m)
+ * (m <= 16) of which those with w[i] > 0 are feasible (kernel times
+ * cosine; z[i] their distance along the ray). */
+typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, const float *w, const float *z);
+typedef struct cdl_skd_count {
+    uint64_t tested, nodes;
+} cdl_skd_count;
+int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_skd_visit fn,
+                        void *ctx, cdl_skd_count *cnt);
+/* The same appended to out. Returns 0, or -1 out of memory. */
 int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_splat_hits *out);
-/* The same by testing every sample of the part (for tests). */
+/* The same by testing every sample of the part one by one with
+ * cdl_splat_weight (for tests: the traversal's leaves test 16 at a time). */
 int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, cdl_splat_hits *out);
 
 #endif
