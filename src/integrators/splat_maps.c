@@ -42,6 +42,16 @@ static void icosahedron(cdl_vec3 *c)
             }
 }
 
+/* RGB of entry k (stratum or coefficient) of sample q: the histogram is
+ * stored as one image per stratum (a ray's splats all go to its stratum:
+ * neighbouring samples, neighbouring entries), SH per sample (a splat
+ * writes all 16). */
+static inline float *map_at(const splat_state *s, uint32_t q, int k)
+{
+    size_t i = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? (size_t)k * s->neye + q : (size_t)q * s->K + (size_t)k;
+    return &s->map[3 * i];
+}
+
 static int stratum(const splat_state *s, cdl_vec3 w)
 {
     int best = 0;
@@ -105,29 +115,27 @@ static void ray_terms(ray_ctx *c)
 }
 
 /* A batch of samples from the tree: the feasible ones get the ray's light. */
-static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *z)
+static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz)
 {
     ray_ctx *c = ctx;
     splat_state *s = c->s;
     if (!c->ready)
         ray_terms(c);
     const int mode = s->opt.splat.mode;
-    const uint32_t K3 = s->K * 3;
     const cdl_vec3 flux = c->r->flux;
     for (uint32_t i = 0; i < m; i++) {
         if (!(w[i] > 0.0f))
             continue;
         uint32_t q = first + i;
-        float wi = w[i], *mp = &s->map[(size_t)q * K3];
+        float wi = w[i], *mp = map_at(s, q, mode == CDL_SPLAT_HISTOGRAM ? c->stratum : 0);
         c->splats++;
         if (mode == CDL_SPLAT_SH) {
             for (int k = 0; k < CDL_SH_N * 3; k++)
                 mp[k] += wi * c->sh[k];
         } else if (mode == CDL_SPLAT_HISTOGRAM) {
-            float *e = &mp[c->stratum * 3];
-            e[0] += wi * flux.x;
-            e[1] += wi * flux.y;
-            e[2] += wi * flux.z;
+            mp[0] += wi * flux.x;
+            mp[1] += wi * flux.y;
+            mp[2] += wi * flux.z;
         } else {
             const splat_eye *ey = &s->eye[q];
             cdl_vec3 f = ey->lambert ? cdl_scale(ey->b.kd, (float)CDL_INV_PI) : cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
@@ -137,7 +145,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, c
         }
         float *si = &s->splat_img[(size_t)q * 2];
         si[0] += wi;
-        si[1] += z[i] > 0.0f ? 1.0f / z[i] : 0.0f;
+        si[1] += iz[i];
     }
 }
 
@@ -187,7 +195,7 @@ void splat_maps_resolve(splat_state *s)
 #pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++) {
         const splat_eye *e = &s->eye[q];
-        const float *m = &s->map[(size_t)q * s->K * 3];
+        const float *m = map_at(s, q, 0);
         cdl_vec3 L;
         if (mode == CDL_SPLAT_DIRECT) {
             L = cdl_v3(m[0], m[1], m[2]);
@@ -195,7 +203,8 @@ void splat_maps_resolve(splat_state *s)
             cdl_vec3 E = cdl_v3(0.0f, 0.0f, 0.0f);
             L = E;
             for (int k = 0; k < SPLAT_STRATA; k++) {
-                cdl_vec3 Ek = cdl_v3(m[k * 3], m[k * 3 + 1], m[k * 3 + 2]);
+                const float *mk = map_at(s, q, k);
+                cdl_vec3 Ek = cdl_v3(mk[0], mk[1], mk[2]);
                 if (cdl_is_black(Ek))
                     continue;
                 if (e->lambert) {
@@ -220,12 +229,13 @@ void splat_maps_resolve(splat_state *s)
         L = cdl_mul(L, e->weight);
         /* pixels take their samples in tree order: one pixel's samples may
          * sit in different parts, so this sum runs after the parallel loop */
-        s->map[(size_t)q * s->K * 3] = L.x;
-        s->map[(size_t)q * s->K * 3 + 1] = L.y;
-        s->map[(size_t)q * s->K * 3 + 2] = L.z;
+        float *out = map_at(s, q, 0);
+        out[0] = L.x;
+        out[1] = L.y;
+        out[2] = L.z;
     }
     for (uint32_t q = 0; q < s->neye; q++) {
-        const float *m = &s->map[(size_t)q * s->K * 3];
+        const float *m = map_at(s, q, 0);
         uint32_t p = s->eye[q].pixel;
         s->pix[p] = cdl_add(s->pix[p], cdl_v3(m[0], m[1], m[2]));
     }

@@ -24,6 +24,23 @@ uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits)
     return a << bits | b;
 }
 
+/* The decoded direction before normalization (its signs are exact). */
+static cdl_vec3 oct_decode_raw(uint32_t e, int bits)
+{
+    uint32_t mask = (1u << bits) - 1u;
+    float m = (float)mask;
+    float u = (float)((e >> bits) & mask) / m * 2.0f - 1.0f;
+    float v = (float)(e & mask) / m * 2.0f - 1.0f;
+    float z = 1.0f - fabsf(u) - fabsf(v);
+    if (z < 0.0f) {
+        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+        u = pu;
+        v = pv;
+    }
+    return cdl_v3(u, v, z);
+}
+
 cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits)
 {
     uint32_t mask = (1u << bits) - 1u;
@@ -156,11 +173,23 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     cdl_vec3 nx = cdl_dot(b->ng, wo) < 0.0f ? cdl_neg(b->ng) : b->ng;
     float r2;
     uint32_t n = gather(m, q, x, &r2);
+    /* Lambertian: f = kd / pi wherever the BSDF reflects, which only the
+     * signs of wi decide (no normalization, no general evaluation) */
+    int lambert = b->type == CDL_MAT_DIFFUSE;
+    float go = cdl_dot(wo, b->ng), so = cdl_dot(wo, b->frame.n) * (go < 0.0f ? -1.0f : 1.0f);
+    cdl_vec3 fd = cdl_scale(b->kd, (float)CDL_INV_PI), zero = cdl_v3(0.0f, 0.0f, 0.0f);
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
         if (left_out(q, ph))
             continue;
-        cdl_vec3 f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
+        cdl_vec3 f;
+        if (lambert) {
+            cdl_vec3 wi = oct_decode_raw(ph->wi & 0x3fffffffu, 15);
+            float gi = cdl_dot(wi, b->ng), si = cdl_dot(wi, b->frame.n) * (go < 0.0f ? -1.0f : 1.0f);
+            f = go * gi > 0.0f && so > 0.0f && si > 0.0f ? fd : zero;
+        } else {
+            f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
+        }
         float w = kernel_w(q->kernel, q->d2[i], r2);
         if (cdl_is_black(f) || !(w > 0.0f) || !visible(q, x, nx, ph))
             continue;

@@ -373,7 +373,7 @@ size_t cdl_skd_bytes(const cdl_skd *t)
            (size_t)t->nparts * sizeof(cdl_skd_part);
 }
 
-static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float z)
+static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
 {
     if (out->n == out->cap) {
         uint32_t cap = out->cap ? 2 * out->cap : 4096;
@@ -385,7 +385,7 @@ static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float z)
         out->h = h;
         out->cap = cap;
     }
-    out->h[out->n++] = (cdl_splat_hit){s, w, z};
+    out->h[out->n++] = (cdl_splat_hit){s, w, iz};
     return 0;
 }
 
@@ -422,7 +422,7 @@ static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ra
         float rr = r2 > 0.0f ? r2 : 0.0f;
         float wi = norm / h2 * (1.0f - rr / h2) * -c;
         w[i] = ok ? wi : 0.0f;
-        zz[i] = z;
+        zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
 }
 
@@ -590,7 +590,7 @@ int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         float z;
         float w = cdl_splat_weight(r, cdl_v3(t->p[0][i], t->p[1][i], t->p[2][i]),
                                    cdl_v3(t->nrm[0][i], t->nrm[1][i], t->nrm[2][i]), t->flags[i], &z);
-        if (w > 0.0f && add_hit(out, i, w, z))
+        if (w > 0.0f && add_hit(out, i, w, z > 0.0f ? 1.0f / z : 0.0f))
             return -1;
     }
     return 0;

@@ -83,10 +83,11 @@ typedef struct cdl_splat_ray {
 } cdl_splat_ray;
 
 /* A feasible eye sample: its tree position, kernel times cosine (per unit
- * flux: the irradiance it receives) and its distance along the ray. */
+ * flux: the irradiance it receives) and one over its distance along the
+ * ray (0 at 0). */
 typedef struct cdl_splat_hit {
     uint32_t s;
-    float w, z;
+    float w, iz;
 } cdl_splat_hit;
 
 typedef struct cdl_splat_hits {
@@ -133,8 +134,8 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
  * (m <= 16) of which those with w[i] > 0 are feasible (kernel times
- * cosine; z[i] their distance along the ray). */
-typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, const float *w, const float *z);
+ * cosine; iz[i] one over their distance along the ray, 0 at 0). */
+typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz);
 typedef struct cdl_skd_count {
     uint64_t tested, nodes;
 } cdl_skd_count;
