@@ -103,19 +103,34 @@ static void traversal(void)
         qsort(b.h, b.n, sizeof *b.h, cmp_hit);
         qsort(c.h, c.n, sizeof *c.h, cmp_hit);
         total += a.n;
-        if (a.n != b.n || a.n != c.n) {
-            wrong++;
-            continue;
-        }
-        for (uint32_t i = 0; i < a.n; i++) {
-            wrong += a.h[i].s != b.h[i].s || a.h[i].s != c.h[i].s;
-            wdiff += fabsf(a.h[i].w - b.h[i].w) > 1e-4f * a.h[i].w || b.h[i].w != c.h[i].w;
+        /* the leaf test runs 16 lanes with its own rounding: a sample on the
+         * kernel's rim (weight ~ 0) may fall either side, and weights agree
+         * to float rounding of the peak weight */
+        float wmax = 0.0f;
+        for (uint32_t i = 0; i < a.n; i++)
+            wmax = fmaxf(wmax, a.h[i].w);
+        const cdl_splat_hits *other[2] = {&b, &c};
+        for (int o = 0; o < 2; o++) {
+            const cdl_splat_hits *x = other[o];
+            uint32_t i = 0, j = 0;
+            while (i < a.n || j < x->n) {
+                if (j >= x->n || (i < a.n && a.h[i].s < x->h[j].s)) {
+                    wrong += a.h[i].w > 1e-3f * wmax;
+                    i++;
+                } else if (i >= a.n || x->h[j].s < a.h[i].s) {
+                    wrong += x->h[j].w > 1e-3f * wmax;
+                    j++;
+                } else {
+                    wdiff += fabsf(a.h[i].w - x->h[j].w) > 1e-4f * wmax;
+                    i++, j++;
+                }
+            }
         }
     }
     CHECK(wrong == 0 && wdiff == 0 && total > 20000,
-          "frustum traversal = brute force over 600 rays (%u feasible samples, %u wrong, %u weights differ by "
-          "more than 1e-4)", total,
-          wrong, wdiff);
+          "frustum traversal = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
+          "differ by more than 1e-4 of the ray's largest)",
+          total, wrong, wdiff);
     CHECK(tested_cull < 20ull * total, "the traversal tests few samples per feasible one (%.2f)",
           (double)tested_cull / total);
     (void)tested_plain;

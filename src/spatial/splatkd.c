@@ -408,7 +408,10 @@ static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ra
         float c = dn - two[i] * (dn + fabsf(dn)); /* -|dn| for a two-sided sample */
         float z = Dx * dx + Dy * dy + Dz * dz;
         float zn = Dx * nx0 + Dy * ny0 + Dz * nz0;
-        float r2 = Dx * Dx + Dy * Dy + Dz * Dz - z * z;
+        /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray
+         * would lose r^2 to cancellation */
+        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
+        float r2 = ex * ex + ey * ey + ez * ez;
         float h = h0 + dh * (z < len ? z : len);
         float h2 = h * h, beyond = z - len;
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f);

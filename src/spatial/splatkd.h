@@ -114,7 +114,8 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
         return 0.0f;
     float h = r->h0 + r->dh * (z < r->len ? z : r->len);
     float h2 = h * h;
-    float r2 = cdl_dot(D, D) - z * z;
+    cdl_vec3 e = cdl_sub(D, cdl_scale(r->d, z)); /* not |D|^2 - z^2: cancellation */
+    float r2 = cdl_dot(e, e);
     if (z > r->len) {
         if (r->cap > 0.0f) {
             /* the ray must have crossed the sample's tangent plane by its end */
