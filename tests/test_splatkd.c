@@ -99,9 +99,10 @@ static void traversal(void)
         for (uint32_t q = 0; q < t.nparts; q++)
             cdl_skd_splat(&t, q, &ray, k % 4 == 0, &c);
         tested_plain += c.tested - t0;
-        qsort(a.h, a.n, sizeof *a.h, cmp_hit);
-        qsort(b.h, b.n, sizeof *b.h, cmp_hit);
-        qsort(c.h, c.n, sizeof *c.h, cmp_hit);
+        cdl_splat_hits *all[3] = {&a, &b, &c};
+        for (int o = 0; o < 3; o++)
+            if (all[o]->n)
+                qsort(all[o]->h, all[o]->n, sizeof *all[o]->h, cmp_hit);
         total += a.n;
         /* the leaf test runs 16 lanes with its own rounding: a sample on the
          * kernel's rim (weight ~ 0) may fall either side, and weights agree
