@@ -62,7 +62,9 @@ static void render_help(void)
            "      --strata KIND       rigi: geometry (threshold G, default) or distance\n"
            "      --aov NAME          rigi: extra EXR layers: pathlength (average eye path\n"
            "                          length, Fig. 4) or strata (the contribution of each\n"
-           "                          eye path length as layers strata1..strata8, Fig. 5)\n"
+           "                          eye path length as layers strata1..strata8, Fig. 5);\n"
+           "                          splat: bandwidth (the kernel-weighted mean bandwidth of\n"
+           "                          the photon rays of depth 2, 3 and any, as R, G, B)\n"
            "      --shadow-rays KIND  rigi/ir/gkde: bundle (one Embree ray stream per point\n"
            "                          light and tile, or per footprint; default) or single;\n"
            "                          pm: a number (below)\n"
@@ -263,8 +265,11 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->aov_pathlength = 1;
             else if (!strcmp(v, "strata"))
                 a->aov_strata = 1;
+            else if (!strcmp(v, "bandwidth"))
+                a->aov_bandwidth = 1;
             else
-                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected pathlength or strata, got '%s'", v);
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected pathlength, strata or bandwidth, got '%s'",
+                                     v);
         } else if (!strcmp(o, "--shadow-rays")) {
             if (!strcmp(v, "bundle"))
                 a->single_shadow_rays = 0;
@@ -290,7 +295,7 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "%ld paths cannot fill %ld x %ld interleaved sets", a->light_paths,
                              a->interleave, a->interleave);
-    if (a->aov_pathlength || a->aov_strata) {
+    if (a->aov_pathlength || a->aov_strata || a->aov_bandwidth) {
         int exr = 0;
         for (int i = 0; i < a->nout; i++)
             exr |= cdl_image_has_ext(a->out[i], ".exr");
@@ -453,6 +458,8 @@ int cdl_cmd_render(int argc, char **argv)
     if (!rc)
         rc = cdl_film_init(&film, a.width, a.height, &err);
     if (!rc && a.aov_pathlength && cdl_film_add_aov(&film, "pathlength", 1, &err) < 0)
+        rc = err.code;
+    if (!rc && a.aov_bandwidth && cdl_film_add_aov(&film, "bandwidth", 3, &err) < 0)
         rc = err.code;
     for (int k = 1; !rc && a.aov_strata && k <= CDL_STRATA; k++) {
         char nm[32];

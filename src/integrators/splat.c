@@ -194,7 +194,7 @@ static int build(splat_state *s, cdl_error *err)
     if (!s->eye) {
         s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1));
         s->map = malloc(sizeof(float) * 3 * s->K * (s->nslots ? s->nslots : 1));
-        s->splat_img = malloc(sizeof(float) * 2 * (s->nslots ? s->nslots : 1));
+        s->splat_img = malloc(sizeof(float) * SPLAT_IMG * (s->nslots ? s->nslots : 1));
         if (!s->eye || !s->map || !s->splat_img)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
@@ -221,6 +221,8 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
         rc = build(s, err);
     double t2 = cdl_time_now();
     s->st.t_build += t2 - t1;
+    int a_bw = cdl_film_find_aov(film, "bandwidth");
+    s->want_bw = a_bw >= 0;
     if (rc || cdl_cancel)
         return rc;
     if (!s->have_pilot) {
@@ -252,6 +254,22 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
         bad += (uint64_t)cdl_film_add(film, (int)(p % (size_t)cam->width), (int)(p / (size_t)cam->width),
                                       cdl_add(s->base[p], s->pix[p]));
     film->nonfinite += bad;
+    if (a_bw >= 0) {
+        /* per pixel: the mean bandwidth of the rays that splatted it, by
+         * the rays' depth (2, 3, any), weighted by their kernels */
+        double *acc = calloc(npix * 6, sizeof(double));
+        if (!acc)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
+        for (uint32_t q = 0; q < s->neye; q++)
+            for (int k = 0; k < 6; k++)
+                acc[6 * (size_t)s->eye[q].pixel + k] += s->splat_img[(size_t)q * SPLAT_IMG + 2 + k];
+        for (size_t p = 0; p < npix; p++)
+            for (int c = 0; c < 3; c++) {
+                double w = acc[6 * p + 2 * c + 1];
+                film->aovs[a_bw].sum[3 * p + c] += w > 0.0 ? acc[6 * p + 2 * c] / w : 0.0;
+            }
+        free(acc);
+    }
     double t5 = cdl_time_now();
     s->st.t_brdf += t5 - t4;
     s->st.samples += s->neye;

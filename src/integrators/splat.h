@@ -12,6 +12,7 @@
 #include "transport/photon_rays.h"
 
 #define SPLAT_STRATA 20 /* icosahedron faces */
+#define SPLAT_IMG 8
 
 /* An eye sample (§3): what the final step needs besides the tree's
  * position and normal. */
@@ -48,7 +49,10 @@ typedef struct splat_state {
     cdl_skd_params kp;
     float *map;       /* per eye sample: K x 3 floats */
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
-    float *splat_img; /* per eye sample: kernel weight sum, sum of 1 / z (for filtering and caching) */
+    float *splat_img; /* per eye sample, SPLAT_IMG floats: kernel weight sum, sum of 1 / z (for
+                       * filtering and caching); with --aov bandwidth the weighted bandwidth
+                       * and weight of rays ending at depth 2, 3 and any depth */
+    int want_bw;
     cdl_vec3 strata[SPLAT_STRATA];
     cdl_sh_rot rot;
     cdl_bsdf_sh *tables; /* per material (SH mode) */

@@ -143,9 +143,21 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, c
             mp[1] += wi * f.y * flux.y;
             mp[2] += wi * f.z * flux.z;
         }
-        float *si = &s->splat_img[(size_t)q * 2];
+        float *si = &s->splat_img[(size_t)q * SPLAT_IMG];
         si[0] += wi;
         si[1] += iz[i];
+        if (s->want_bw) {
+            const cdl_photon_ray *r = c->r;
+            float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
+            float h = r->h0 + r->dh * (z < r->len ? z : r->len);
+            int d = r->depth == 2 ? 0 : r->depth == 3 ? 1 : -1;
+            if (d >= 0) {
+                si[2 + 2 * d] += wi * h;
+                si[3 + 2 * d] += wi;
+            }
+            si[6] += wi * h;
+            si[7] += wi;
+        }
     }
 }
 
@@ -154,7 +166,7 @@ int splat_maps_splat(splat_state *s, cdl_error *err)
     (void)err;
     size_t n = (size_t)s->neye * s->K * 3;
     memset(s->map, 0, sizeof(float) * (n ? n : 1));
-    memset(s->splat_img, 0, sizeof(float) * 2 * (s->neye ? s->neye : 1));
+    memset(s->splat_img, 0, sizeof(float) * SPLAT_IMG * (s->neye ? s->neye : 1));
     uint64_t splats = 0, tested = 0, nodes = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
     for (uint32_t part = 0; part < s->tree.nparts; part++) {
