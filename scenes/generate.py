@@ -776,6 +776,65 @@ def caustic_ring():
     return s
 
 
+def wave():
+    """Herzog et al. 2007, Table 7.1's WAVE row: a Cornell-like box (2 m) whose
+    floor and back wall are smooth bumpy height fields (about 20000 triangles
+    with vertex normals, like the report's 19635), a glossy box and a glass
+    sphere: curved surfaces where a photon map's disc around a point is not
+    the surface, and 2 % non-diffuse material."""
+    s = Scene("wave")
+    L, H, T = 2.0, 2.0, 0.1
+    white = s.material("white", kd=(0.72, 0.71, 0.68))
+    red = s.material("red", kd=(0.63, 0.07, 0.05))
+    green = s.material("green", kd=(0.15, 0.48, 0.09))
+    bumpy = s.material("bumpy", kd=(0.70, 0.70, 0.66))
+    glossy = s.material("glossy", kd=(0.25, 0.25, 0.3), ks=(0.45, 0.45, 0.45), ns=40)
+    glass = s.material("glass", kd=(0, 0, 0), ks=(1, 1, 1), ni=1.5, illum=7)
+    lamp = s.material("light", kd=(0.78, 0.78, 0.78), ke=(17, 12, 4))
+    s.shell(-L / 2, L / 2, -L / 2, L / 2, H, T, white, white, white, {"-x": red, "+x": green})
+    s.group("light")
+    s.light(0.0, 0.0, 0.47, 0.38, H - 0.005, lamp)
+    N = 70
+
+    def field(u, v):  # bumps in [0, 1] over the unit square, smooth at the edges
+        return 0.5 + 0.25 * math.sin(7.0 * u + 1.3) * math.sin(6.0 * v + 0.4) + 0.25 * math.sin(13.0 * u * v)
+
+    def surface(origin, du, dv, dn, amp, mtl):
+        """A height field origin + u du + v dv + amp field(u, v) dn, u, v in [0, 1],
+        with vertex normals from its partial derivatives."""
+        eps = 1e-4
+        pts, nrm = {}, {}
+        for i in range(N + 1):
+            for j in range(N + 1):
+                u, v = i / N, j / N
+                f = field(u, v)
+                fu = (field(u + eps, v) - field(u - eps, v)) / (2 * eps)
+                fv = (field(u, v + eps) - field(u, v - eps)) / (2 * eps)
+                pts[i, j] = tuple(origin[k] + u * du[k] + v * dv[k] + amp * f * dn[k] for k in range(3))
+                tu = tuple(du[k] + amp * fu * dn[k] for k in range(3))
+                tv = tuple(dv[k] + amp * fv * dn[k] for k in range(3))
+                n = _norm(_cross(tu, tv))
+                nrm[i, j] = n if _dot(n, dn) > 0 else (-n[0], -n[1], -n[2])
+        for i in range(N):
+            for j in range(N):
+                a, b, c, d = (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)
+                for tri in ((a, b, c), (a, c, d)):
+                    p = [pts[t] for t in tri]
+                    if _dot(_cross(_sub(p[1], p[0]), _sub(p[2], p[0])), dn) < 0:
+                        tri = tri[::-1]
+                    s.tri(pts[tri[0]], pts[tri[1]], pts[tri[2]], mtl, nrm[tri[0]], nrm[tri[1]], nrm[tri[2]])
+    s.group("bumpy_floor")
+    surface((-L / 2, 0.0, -L / 2), (L, 0, 0), (0, 0, L), (0, 1, 0), 0.08, bumpy)
+    s.group("bumpy_back_wall")
+    surface((-L / 2, 0.0, -L / 2), (L, 0, 0), (0, H, 0), (0, 0, 1), 0.08, bumpy)
+    s.group("glossy_box")
+    s.box((0.15, 0.05, -0.55), (0.6, 0.65, -0.1), glossy, rot=(-17, (0.375, -0.325)))
+    s.group("glass_sphere")
+    s.sphere((-0.45, 0.4, -0.2), 0.22, glass, nu=32, nv=16)
+    s.camera = ((0.0, 1.45, 0.97), (0.0, 0.45, -1.0), 78)  # inside: the shell is closed
+    return s
+
+
 def building():
     """Bekaert et al. 2003, Fig. 6: a large building floor (120 x 60 m) of 276
     furnished offices along five long corridors and three cross corridors, lit by
@@ -964,6 +1023,7 @@ SCENES = {
     "grazing": grazing,
     "floor_many_lights": floor_many_lights,
     "caustic_ring": caustic_ring,
+    "wave": wave,
 }
 # Written only when named: too large to commit (about 300k triangles, 15 MB of OBJ),
 # so not part of the default "all scenes" and not in scenes/generated in git.

@@ -83,7 +83,9 @@ static int push(ray_buf *b, const cdl_photon_ray *r, uint32_t path)
 static double bandwidth(const trace_ctx *cx, int cat, double pt)
 {
     const cdl_pray_params *pp = cx->pp;
-    double base = cx->base[cat], lo = base * pp->mu * pp->R, hi = base * pp->mu / pp->R;
+    /* around the mean bandwidth C m0 mu_C / M^(1/6) (the report prints the
+     * bounds without m0, which would put the mean above the upper one) */
+    double base = cx->base[cat], mean = base * M0 * pp->mu, lo = mean * pp->R, hi = mean / pp->R;
     if (!(pt > 0.0))
         return hi;
     double h = base * pp->w * pow(pt, -0.5 * pp->S);

@@ -9,7 +9,9 @@
  *   w = m0 mu_C / mean(1 / sqrt(p~^S)),  mu_C = a mean|x_i - x_{i-1}|       (eq. 4.10-4.11)
  *
  * (densities per projected solid angle; a = 0.2, m0 = 10^(5/6); the means
- * from a pilot set of paths), clamped to C / M^(1/6) mu_C [R, 1/R]. A ray
+ * from a pilot set of paths), clamped to the mean C m0 mu_C / M^(1/6) times
+ * [R, 1/R] (the report prints the bounds without m0, which would put the
+ * mean bandwidth above the upper bound). A ray
  * stores h0 = min(h(x_i), h(x_{i-1})) and dh = max(0, h(x_i) - h(x_{i-1})) /
  * |x_i - x_{i-1}|. Lengths are in scene units throughout: mu_C and D~ come
  * from the scene, so the report's metre convention needs no conversion.
