@@ -104,8 +104,10 @@ int cdl_pm_arg(const char *o, const char *v, cdl_pm_options *pm, cdl_error *err)
             pm->direct = CDL_DIRECT_LCON_BIASED;
         else if (!strcmp(v, "photons"))
             pm->direct_photons = 1;
+        else if (!strcmp(v, "none"))
+            pm->direct = CDL_DIRECT_NONE;
         else
-            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power (or sample), lcon, lcon-biased or photons, got '%s'",
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected power (or sample), lcon, lcon-biased, photons or none, got '%s'",
                                  v);
         if (strcmp(v, "photons"))
             pm->direct_photons = 0;
@@ -152,7 +154,8 @@ void cdl_pm_args_help(void)
            "                          (S rays to the lights of nearby primary photons, one to\n"
            "                          the rest), lcon-biased (none to the rest) or photons\n"
            "                          (read from the photon map: its primary photons seen\n"
-           "                          directly; needs --gather 0)\n"
+           "                          directly; needs --gather 0) or none (indirect light\n"
+           "                          alone, for comparisons)\n"
            "      --shadow-rays S     direct-light shadow rays per shading point (default 4)\n"
            "      --lcon-radius R     radius of the L_con query (default: --max-radius)\n"
            "      --photon-paths-max N  give up when N paths per pass have not stored\n"

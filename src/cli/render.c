@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "cli/gkde_args.h"
 #include "cli/splat_args.h"
+#include "transport/light_select.h"
 #include "cli/pm_args.h"
 #include "cli/render_args.h"
 #include "core/log.h"
@@ -415,7 +416,9 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
     if (a->photons_given)
         opt->splat.photons = a->pm.photons;
     if (a->direct_given)
-        opt->splat.direct_sample = !a->pm.direct_photons;
+        opt->splat.direct_sample = !a->pm.direct_photons && a->pm.direct != CDL_DIRECT_NONE;
+    if (a->direct_given && a->pm.direct == CDL_DIRECT_NONE)
+        opt->splat.fractions[0] = 0.0f; /* no direct light: indirect light alone */
     if (!rc && a->has_lookat)
         rc = cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
                              cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),

@@ -54,7 +54,7 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
                                &st->global, &st->caustic, &st->last, err);
     if (rc)
         return rc;
-    if (st->dcfg.kind != CDL_DIRECT_POWER && !st->direct.built) {
+    if (st->dcfg.kind != CDL_DIRECT_POWER && st->dcfg.kind != CDL_DIRECT_NONE && !st->direct.built) {
         /* the primary photons of the first pass on their own, for the L_con
          * ball queries; kept for all passes: L_con then stays the same set at
          * a point, so each light's samples stay stratified over the passes */
@@ -344,7 +344,7 @@ static void pm_report(const void *self)
         printf("; %u importons from %llu paths (%.2f MiB, %.2f s), f = %.4g from %u test rays", st->imp.n,
                (unsigned long long)st->imp.paths, (double)cdl_importance_bytes(&st->imp) * mib,
                st->t_importons, st->imp.f, st->imp.tests);
-    if (st->dcfg.kind != CDL_DIRECT_POWER && st->lcon_points)
+    if (st->dcfg.kind != CDL_DIRECT_POWER && st->dcfg.kind != CDL_DIRECT_NONE && st->lcon_points)
         printf("; |L_con| %.2f on average of %u lights", (double)st->lcon_sum / (double)st->lcon_points,
                st->scene->nlights);
     printf("\n");

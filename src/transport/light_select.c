@@ -90,7 +90,7 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
     cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
     uint32_t S = cfg->shadow_rays ? cfg->shadow_rays : 1;
     *nlcon = 0;
-    if (!s->nlights)
+    if (!s->nlights || cfg->kind == CDL_DIRECT_NONE)
         return L;
     if (cfg->kind == CDL_DIRECT_POWER) {
         for (uint32_t i = 0; i < S; i++) {

@@ -12,7 +12,8 @@
 #include "scene/scene.h"
 #include "spatial/photon_map.h"
 
-typedef enum { CDL_DIRECT_POWER, CDL_DIRECT_LCON, CDL_DIRECT_LCON_BIASED } cdl_direct_kind;
+/* NONE: no direct light at all (indirect light alone, for comparisons) */
+typedef enum { CDL_DIRECT_POWER, CDL_DIRECT_LCON, CDL_DIRECT_LCON_BIASED, CDL_DIRECT_NONE } cdl_direct_kind;
 
 /* Per-thread scratch: a mark and a slot per light. */
 typedef struct cdl_lcon_scratch {
