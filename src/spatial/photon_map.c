@@ -8,55 +8,6 @@
 
 /* Octahedral map of the unit sphere to [-1, 1]^2: uniform precision,
  * 15 bits per coordinate are better than 0.01 degrees. */
-uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits)
-{
-    float s = fabsf(d.x) + fabsf(d.y) + fabsf(d.z);
-    float u = s > 0.0f ? d.x / s : 0.0f, v = s > 0.0f ? d.y / s : 0.0f;
-    if (d.z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    float m = (float)((1u << bits) - 1u);
-    uint32_t a = (uint32_t)lrintf((u * 0.5f + 0.5f) * m);
-    uint32_t b = (uint32_t)lrintf((v * 0.5f + 0.5f) * m);
-    return a << bits | b;
-}
-
-/* The decoded direction before normalization (its signs are exact). */
-static cdl_vec3 oct_decode_raw(uint32_t e, int bits)
-{
-    uint32_t mask = (1u << bits) - 1u;
-    float m = (float)mask;
-    float u = (float)((e >> bits) & mask) / m * 2.0f - 1.0f;
-    float v = (float)(e & mask) / m * 2.0f - 1.0f;
-    float z = 1.0f - fabsf(u) - fabsf(v);
-    if (z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    return cdl_v3(u, v, z);
-}
-
-cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits)
-{
-    uint32_t mask = (1u << bits) - 1u;
-    float m = (float)mask;
-    float u = (float)((e >> bits) & mask) / m * 2.0f - 1.0f;
-    float v = (float)(e & mask) / m * 2.0f - 1.0f;
-    float z = 1.0f - fabsf(u) - fabsf(v);
-    if (z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    return cdl_normalize(cdl_v3(u, v, z));
-}
-
 void cdl_pmap_init(cdl_photon_map *m) { memset(m, 0, sizeof *m); }
 
 void cdl_pmap_free(cdl_photon_map *m)
@@ -184,7 +135,7 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
             continue;
         cdl_vec3 f;
         if (lambert) {
-            cdl_vec3 wi = oct_decode_raw(ph->wi & 0x3fffffffu, 15);
+            cdl_vec3 wi = cdl_oct_decode_raw(ph->wi & 0x3fffffffu, 15);
             float gi = cdl_dot(wi, b->ng), si = cdl_dot(wi, b->frame.n) * (go < 0.0f ? -1.0f : 1.0f);
             f = go * gi > 0.0f && so > 0.0f && si > 0.0f ? fd : zero;
         } else {

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "core/octahedral.h"
 #include "core/vec.h"
 #include "scene/bsdf.h"
 #include "spatial/pointkd.h"
@@ -42,8 +43,6 @@ static inline uint32_t cdl_photon_depth(const cdl_photon *ph)
 }
 
 /* Octahedral encoding (Meyer et al. 2010) with `bits` per coordinate. */
-uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits);
-cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits);
 static inline cdl_vec3 cdl_photon_wi(const cdl_photon *ph) { return cdl_oct_decode_bits(ph->wi & 0x3fffffffu, 15); }
 static inline cdl_vec3 cdl_photon_n(const cdl_photon *ph) { return cdl_oct_decode_bits(ph->n, 8); }
 

@@ -1,5 +1,7 @@
 #include "spatial/splatkd.h"
 
+#include "core/octahedral.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,35 +34,6 @@ static float bitsf(uint32_t u)
     float f;
     memcpy(&f, &u, sizeof f);
     return f;
-}
-
-/* Octahedral encoding of a unit vector, 16 bits per coordinate. */
-static uint32_t oct_encode(cdl_vec3 n)
-{
-    float s = fabsf(n.x) + fabsf(n.y) + fabsf(n.z);
-    float u = n.x / s, v = n.y / s;
-    if (n.z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    uint32_t qu = (uint32_t)lrintf((u * 0.5f + 0.5f) * 65535.0f);
-    uint32_t qv = (uint32_t)lrintf((v * 0.5f + 0.5f) * 65535.0f);
-    return qu | qv << 16;
-}
-
-static cdl_vec3 oct_decode(uint32_t e)
-{
-    float u = (float)(e & 0xffff) / 65535.0f * 2.0f - 1.0f, v = (float)(e >> 16) / 65535.0f * 2.0f - 1.0f;
-    float z = 1.0f - fabsf(u) - fabsf(v);
-    if (z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    return cdl_normalize(cdl_v3(u, v, z));
 }
 
 typedef struct builder {
@@ -110,8 +83,8 @@ static int try_cull(builder *b, uint32_t lo, uint32_t hi)
     float len = cdl_length(m);
     if (!(len > 0.0f))
         return 0;
-    uint32_t code = oct_encode(cdl_scale(m, 1.0f / len));
-    cdl_vec3 r = oct_decode(code); /* the deviation is measured from what the node holds */
+    uint32_t code = cdl_oct_encode_bits(cdl_scale(m, 1.0f / len), 16);
+    cdl_vec3 r = cdl_oct_decode_bits(code, 16); /* the deviation is measured from what the node holds */
     float cmin = 1.0f;
     for (uint32_t i = lo; i < hi; i++) {
         float c = cdl_dot(r, b->n[b->idx[i]]);
@@ -480,7 +453,7 @@ static int traverse(const trav *v, uint32_t node, float t0, float t1)
             /* culling node: every sample faces away from the ray */
             if (v->cull) {
                 float cmax = (float)(nd.b >> 16) / 65535.0f;
-                if (cdl_dot(v->r->d, oct_decode(nd.a)) >= cmax)
+                if (cdl_dot(v->r->d, cdl_oct_decode_bits(nd.a, 16)) >= cmax)
                     return 0;
             }
             node++;
