@@ -390,7 +390,10 @@ static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ra
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f);
         if (plane) {
             float tp = (Dx * nx[i] + Dy * ny[i] + Dz * nz[i]) / dn;
-            ok &= (beyond <= 0.0f) | ((beyond <= cap * h) & (tp <= len * 1.0001f + 1e-3f * h));
+            /* reached the sample's tangent plane, or ended within h of the
+             * sample (a neighbouring surface of a concave corner) */
+            ok &= (beyond <= 0.0f) | ((beyond <= cap * h) & ((tp <= len * 1.0001f + 1e-3f * h) |
+                                                             (r2 + beyond * beyond < h2)));
         } else {
             h2 -= beyond > 0.0f ? beyond * beyond : 0.0f;
         }

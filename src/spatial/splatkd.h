@@ -74,8 +74,11 @@ size_t cdl_skd_bytes(const cdl_skd *t);
  *        34 degrees, 0.89 at 57) whatever h: a bias that never vanishes;
  *   c>0  a sample is fed if the ray reached its tangent plane before
  *        ending (so a plane's own samples all are, and a blocker's shadow
- *        stays dark), out to c h(len) beyond x_i: the irradiance on a plane
- *        is exact up to incidence atan(c), and the estimate consistent. */
+ *        stays dark) or ended within h of it (a neighbouring surface of a
+ *        concave corner: the rays that would have landed in the part of the
+ *        kernel beyond the corner), out to c h(len) beyond x_i, with the
+ *        plain kernel: the irradiance on a plane is exact up to incidence
+ *        atan(c), and the estimate consistent. */
 typedef struct cdl_splat_ray {
     cdl_vec3 o, d, on;
     float len, h0, dh;
@@ -120,7 +123,8 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
         if (r->cap > 0.0f) {
             /* the ray must have crossed the sample's tangent plane by its end */
             float tp = cdl_dot(D, n) / dn;
-            if (z > r->len + r->cap * h || tp > r->len * 1.0001f + 1e-3f * h)
+            float b = z - r->len;
+            if (z > r->len + r->cap * h || (tp > r->len * 1.0001f + 1e-3f * h && !(r2 + b * b < h2)))
                 return 0.0f;
         } else {
             h2 -= (z - r->len) * (z - r->len);
