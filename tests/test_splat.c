@@ -5,8 +5,10 @@
  *    bias the report removes; its centre matches the closed form;
  *  - a quad's underside, which no photon reaches, stays black;
  *  - on a Lambertian surface the three radiance maps (direct, histogram,
- *    SH) give the same image. */
+ *    SH) give the same image;
+ *  - the bandwidth picture (--aov bandwidth) in a closed room. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "test_util.h"
@@ -102,6 +104,93 @@ static void setup(cdl_options *opt, int from_below)
     opt->pm.k = 200;
 }
 
+/* A closed room [-1, 1]^3 (walls facing in) with a light panel under the
+ * ceiling: light bounces many times. */
+static void build_room(cdl_scene *s)
+{
+    cdl_error err;
+    die_on(cdl_scene_init(s, "room", &err), &err);
+    cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
+    m.kd = cdl_v3(0.7f, 0.7f, 0.7f);
+    uint32_t mid, first;
+    int32_t emit;
+    die_on(cdl_scene_add_material(s, &m, &mid, &err), &err);
+    /* 8 corners; each face listed counter-clockwise seen from inside */
+    float c[24] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
+    die_on(cdl_scene_add_vertices(s, 8, c, NULL, NULL, &first, &err), &err);
+    static const int f[6][4] = {{0, 1, 2, 3}, {5, 4, 7, 6}, {4, 0, 3, 7}, {1, 5, 6, 2}, {4, 5, 1, 0}, {3, 2, 6, 7}};
+    for (int k = 0; k < 6; k++) {
+        die_on(cdl_scene_add_triangle(s, first + f[k][0], first + f[k][1], first + f[k][2], mid, -1, 0, &err), &err);
+        die_on(cdl_scene_add_triangle(s, first + f[k][0], first + f[k][2], first + f[k][3], mid, -1, 0, &err), &err);
+    }
+    float l[12] = {-0.3f, 0.99f, -0.3f, 0.3f, 0.99f, -0.3f, 0.3f, 0.99f, 0.3f, -0.3f, 0.99f, 0.3f};
+    die_on(cdl_scene_add_emitter(s, cdl_v3(5.0f, 5.0f, 5.0f), 0, &emit, &err), &err);
+    die_on(cdl_scene_add_vertices(s, 4, l, NULL, NULL, &first, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 1, first + 2, mid, emit, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 2, first + 3, mid, emit, 0, &err), &err);
+    die_on(cdl_scene_commit(s, &err), &err);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* --aov bandwidth (Figure 4.4) on the McGuire-like scene: every pixel's
+ * mean bandwidth lies within the clamp's range (a ratio of at most 1/R^2
+ * between any two), and rays of depth 3 get wider kernels than those of
+ * depth 2 (their path densities are lower), as the report shows. */
+static void bandwidth_picture(void)
+{
+    cdl_scene room;
+    build_room(&room);
+    const cdl_scene *s = &room;
+    cdl_options opt;
+    setup(&opt, 0);
+    cdl_error e0;
+    die_on(cdl_camera_init(&opt.camera, cdl_v3(0.0f, 0.0f, 0.95f), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 80.0f, W, H, &e0),
+           &e0);
+    opt.maxdepth = 8;
+    opt.splat.fractions[0] = 0.3f;
+    opt.splat.fractions[1] = 0.7f;
+    cdl_error err;
+    cdl_integrator it;
+    cdl_film f;
+    die_on(cdl_integrator_create("splat", &it, &err), &err);
+    die_on(it.vt->prepare(it.self, s, &opt, &err), &err);
+    die_on(cdl_film_init(&f, W, H, &err), &err);
+    int a = cdl_film_add_aov(&f, "bandwidth", 3, &err);
+    die_on(a < 0, &err);
+    die_on(it.vt->render_pass(it.self, &f, 0, &err), &err);
+    double lo = INFINITY, hi = 0.0, *d2 = malloc(sizeof(double) * W * H), *d3 = malloc(sizeof(double) * W * H);
+    int n2 = 0, n3 = 0;
+    for (int p = 0; p < W * H; p++) {
+        const double *v = &f.aovs[a].sum[3 * p];
+        for (int c = 0; c < 3; c++)
+            if (v[c] > 0.0) {
+                lo = fmin(lo, v[c]);
+                hi = fmax(hi, v[c]);
+            }
+        if (v[0] > 0.0)
+            d2[n2++] = v[0];
+        if (v[1] > 0.0)
+            d3[n3++] = v[1];
+    }
+    qsort(d2, (size_t)n2, sizeof *d2, cmp_double);
+    qsort(d3, (size_t)n3, sizeof *d3, cmp_double);
+    double R = opt.splat.R;
+    CHECK(n2 > 100 && hi / lo <= 1.0001 / (R * R), "bandwidth picture: %d pixels, bandwidths %.3g .. %.3g (ratio %.1f, "
+          "at most 1/R^2 = %.0f)", n2, lo, hi, hi / lo, 1.0 / (R * R));
+    CHECK(n3 > 100 && d3[n3 / 2] > d2[n2 / 2], "rays of depth 3 get wider kernels than depth 2 (medians %.3g, %.3g)",
+          d3[n3 / 2], d2[n2 / 2]);
+    free(d2);
+    free(d3);
+    cdl_film_free(&f);
+    cdl_integrator_destroy(&it);
+    cdl_scene_free(&room);
+}
+
 int main(void)
 {
     cdl_scene s;
@@ -146,6 +235,7 @@ int main(void)
     render_film("splat", &s, &opt, W, H, 2, &fb);
     ring rb = measure(&fb, &opt.camera, band);
     CHECK(rb.centre == 0.0 && rb.edge == 0.0, "the underside stays black (%g, %g)", rb.centre, rb.edge);
+    bandwidth_picture();
     cdl_film_free(&fs);
     cdl_film_free(&fp);
     cdl_film_free(&fh);
