@@ -17,7 +17,6 @@
  * threads. */
 #include "integrators/splat.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -125,7 +124,6 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
             e->wo = v.wo;
             e->pixel = p;
             e->mat = v.sf.mat;
-            e->lambert = v.b.type == CDL_MAT_DIFFUSE;
             cdl_vec3 ng = cdl_dot(v.sf.ng, v.wo) < 0.0f ? cdl_neg(v.sf.ng) : v.sf.ng;
             cdl_vec3 n = v.b.frame.n;
             if (cdl_dot(n, v.wo) < 0.0f)
@@ -240,11 +238,11 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     s->st.rays_stored += s->rays.n;
     double t3 = cdl_time_now();
     s->st.t_light += t3 - t2;
-    rc = splat_maps_splat(s, err);
+    splat_maps_splat(s);
     double t4 = cdl_time_now();
     s->st.t_solve += t4 - t3;
-    if (rc || cdl_cancel)
-        return rc; /* an interrupted pass adds nothing */
+    if (cdl_cancel)
+        return 0; /* an interrupted pass adds nothing */
     const cdl_camera *cam = &s->opt.camera;
     size_t npix = (size_t)cam->width * (size_t)cam->height;
     memset(s->pix, 0, sizeof *s->pix * npix);

@@ -22,7 +22,6 @@ typedef struct splat_eye {
     cdl_vec3 wo;     /* towards the camera */
     cdl_frame f;     /* shading normal on the seen side; t towards wo (SH tables) */
     uint32_t pixel, mat;
-    uint8_t lambert; /* a diffuse BSDF: f = kd / pi */
 } splat_eye;
 
 typedef struct splat_stats {
@@ -62,7 +61,7 @@ typedef struct splat_state {
 /* Radiance-map setup of the mode (strata, SH tables); 0 or an error. */
 int splat_maps_init(splat_state *s, cdl_error *err);
 /* Splats every photon ray into the maps, part by part on all threads. */
-int splat_maps_splat(splat_state *s, cdl_error *err);
+void splat_maps_splat(splat_state *s);
 /* Each eye sample's reflected radiance, weighted, into s->pix. */
 void splat_maps_resolve(splat_state *s);
 

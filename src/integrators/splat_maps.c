@@ -13,7 +13,6 @@
  * thread meeting the rays in their order: the maps do not depend on the
  * thread count. */
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -138,7 +137,8 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, c
             mp[2] += wi * flux.z;
         } else {
             const splat_eye *ey = &s->eye[q];
-            cdl_vec3 f = ey->lambert ? cdl_scale(ey->b.kd, (float)CDL_INV_PI) : cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
+            cdl_vec3 f = ey->b.type == CDL_MAT_DIFFUSE ? cdl_scale(ey->b.kd, (float)CDL_INV_PI)
+                                                       : cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
             mp[0] += wi * f.x * flux.x;
             mp[1] += wi * f.y * flux.y;
             mp[2] += wi * f.z * flux.z;
@@ -161,9 +161,8 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, c
     }
 }
 
-int splat_maps_splat(splat_state *s, cdl_error *err)
+void splat_maps_splat(splat_state *s)
 {
-    (void)err;
     size_t n = (size_t)s->neye * s->K * 3;
     memset(s->map, 0, sizeof(float) * (n ? n : 1));
     memset(s->splat_img, 0, sizeof(float) * SPLAT_IMG * (s->neye ? s->neye : 1));
@@ -188,7 +187,6 @@ int splat_maps_splat(splat_state *s, cdl_error *err)
     s->st.splats += splats;
     s->st.tested += tested;
     s->st.nodes += nodes;
-    return 0;
 }
 
 /* The stratum's centre, moved just above the horizon of n if it lies
@@ -207,6 +205,7 @@ void splat_maps_resolve(splat_state *s)
 #pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++) {
         const splat_eye *e = &s->eye[q];
+        const int lambert = e->b.type == CDL_MAT_DIFFUSE;
         const float *m = map_at(s, q, 0);
         cdl_vec3 L;
         if (mode == CDL_SPLAT_DIRECT) {
@@ -219,14 +218,14 @@ void splat_maps_resolve(splat_state *s)
                 cdl_vec3 Ek = cdl_v3(mk[0], mk[1], mk[2]);
                 if (cdl_is_black(Ek))
                     continue;
-                if (e->lambert) {
+                if (lambert) {
                     E = cdl_add(E, Ek);
                     continue;
                 }
                 cdl_vec3 wi = above(s->strata[k], e->f.n);
                 L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&e->b, e->wo, wi, 0), Ek));
             }
-            if (e->lambert)
+            if (lambert)
                 L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), E);
         } else {
             float loc[CDL_SH_N * 3], c[CDL_SH_N * 3];

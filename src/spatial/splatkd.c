@@ -99,14 +99,32 @@ static int try_cull(builder *b, uint32_t lo, uint32_t hi)
     return 1;
 }
 
-static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled, uint32_t depth)
+static void add_part(cdl_skd *t, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
+{
+    cdl_skd_part *p = &t->parts[t->nparts++];
+    p->node = node;
+    p->lo = lo;
+    p->hi = hi;
+    memcpy(p->bmin, mn, sizeof p->bmin);
+    memcpy(p->bmax, mx, sizeof p->bmax);
+}
+
+/* The subtree over idx[lo, hi) in the cell [mn, mx], `depth` splits below
+ * the root. A part is the subtree at depth part_depth, or a shallower one
+ * that does not split (a leaf, an empty node) or starts with a culling
+ * node; in_part: an ancestor is one. */
+static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled, uint32_t depth,
+                  int in_part)
 {
     cdl_skd *t = b->t;
     if (b->fail)
         return;
     if (depth > t->depth)
         t->depth = depth;
+    uint32_t first = t->nnodes;
     if (lo == hi) {
+        if (!in_part)
+            add_part(t, first, lo, hi, mn, mx);
         push(b, 0, 3u | (uint32_t)KIND_EMPTY << 2);
         t->empties++;
         return;
@@ -114,6 +132,10 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
     if (!culled && b->cos_cull > -2.0f && hi - lo < b->cull_below && try_cull(b, lo, hi)) {
         culled = 1;
         t->culls++;
+        if (!in_part) {
+            add_part(t, first, lo, hi, mn, mx);
+            in_part = 1;
+        }
     }
     float d[3] = {mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2]};
     float diag = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -167,6 +189,10 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
             mid = i;
         }
     }
+    if (!in_part && (axis < 0 || depth == b->prm->part_depth)) {
+        add_part(t, first, lo, hi, mn, mx);
+        in_part = 1;
+    }
     if (axis < 0) {
         push(b, hi - lo, 3u | (uint32_t)KIND_LEAF << 2 | lo << 4);
         t->leaves++;
@@ -175,7 +201,7 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
     uint32_t node = push(b, fbits(split), (uint32_t)axis);
     float keep = mx[axis];
     mx[axis] = split;
-    build(b, lo, mid, mn, mx, culled, depth + 1);
+    build(b, lo, mid, mn, mx, culled, depth + 1, in_part);
     mx[axis] = keep;
     if (b->fail)
         return;
@@ -186,74 +212,8 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
     t->nodes[node].b |= t->nnodes << 2;
     keep = mn[axis];
     mn[axis] = split;
-    build(b, mid, hi, mn, mx, culled, depth + 1);
+    build(b, mid, hi, mn, mx, culled, depth + 1, in_part);
     mn[axis] = keep;
-}
-
-static void add_part(cdl_skd *t, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
-{
-    cdl_skd_part *p = &t->parts[t->nparts++];
-    p->node = node;
-    p->lo = lo;
-    p->hi = hi;
-    memcpy(p->bmin, mn, sizeof p->bmin);
-    memcpy(p->bmax, mx, sizeof p->bmax);
-}
-
-/* Sample range of the subtree at node (its nodes end where the range's
- * last leaf is). */
-static void subtree_range(const cdl_skd *t, uint32_t node, uint32_t *lo, uint32_t *hi)
-{
-    for (;;) {
-        cdl_skd_node nd = t->nodes[node];
-        if ((nd.b & 3) < 3) {
-            uint32_t l0, l1, r0, r1;
-            subtree_range(t, node + 1, &l0, &l1);
-            subtree_range(t, nd.b >> 2, &r0, &r1);
-            *lo = l0 < r0 ? l0 : r0;
-            *hi = l1 > r1 ? l1 : r1;
-            if (l0 == l1) {
-                *lo = r0;
-                *hi = r1;
-            } else if (r0 == r1) {
-                *lo = l0;
-                *hi = l1;
-            }
-            return;
-        }
-        uint32_t kind = (nd.b >> 2) & 3;
-        if (kind == KIND_CULL) {
-            node++;
-            continue;
-        }
-        if (kind == KIND_LEAF) {
-            *lo = nd.b >> 4;
-            *hi = *lo + nd.a;
-        } else {
-            *lo = *hi = 0;
-        }
-        return;
-    }
-}
-
-static void make_parts(cdl_skd *t, uint32_t node, float *mn, float *mx, uint32_t depth)
-{
-    cdl_skd_node nd = t->nodes[node];
-    if (depth == 0 || (nd.b & 3) == 3) {
-        uint32_t lo, hi;
-        subtree_range(t, node, &lo, &hi);
-        add_part(t, node, lo, hi, mn, mx);
-        return;
-    }
-    int a = (int)(nd.b & 3);
-    float s = bitsf(nd.a), keep = mx[a];
-    mx[a] = s;
-    make_parts(t, node + 1, mn, mx, depth - 1);
-    mx[a] = keep;
-    keep = mn[a];
-    mn[a] = s;
-    make_parts(t, nd.b >> 2, mn, mx, depth - 1);
-    mn[a] = keep;
 }
 
 int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_t *flags, uint32_t n_samples,
@@ -280,14 +240,13 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
     memcpy(t->bmax, mx, sizeof mx);
     size_t m = n_samples ? n_samples : 1;
     t->order = malloc(sizeof(uint32_t) * m);
-    t->flags = malloc(m);
     t->two = calloc(m + 16, sizeof(float));
     for (int a = 0; a < 3; a++) { /* 16 floats of room: the leaf test reads 16 lanes */
         t->p[a] = calloc(m + 16, sizeof(float));
         t->nrm[a] = calloc(m + 16, sizeof(float));
     }
     t->parts = malloc(sizeof(cdl_skd_part) << prm->part_depth);
-    int ok = t->order && t->flags && t->two && t->parts;
+    int ok = t->order && t->two && t->parts;
     for (int a = 0; a < 3; a++)
         ok = ok && t->p[a] && t->nrm[a];
     if (!ok) {
@@ -305,7 +264,7 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
     float bmn[3], bmx[3];
     memcpy(bmn, mn, sizeof bmn);
     memcpy(bmx, mx, sizeof bmx);
-    build(&b, 0, n_samples, bmn, bmx, 0, 0);
+    build(&b, 0, n_samples, bmn, bmx, 0, 0, 0);
     if (b.fail) {
         cdl_skd_free(t);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
@@ -317,12 +276,8 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
             t->p[a][i] = v[a];
             t->nrm[a][i] = w[a];
         }
-        t->flags[i] = flags ? flags[s] : 0;
-        t->two[i] = (t->flags[i] & CDL_SKD_TWO_SIDED) ? 1.0f : 0.0f;
+        t->two[i] = flags && (flags[s] & CDL_SKD_TWO_SIDED) ? 1.0f : 0.0f;
     }
-    memcpy(bmn, mn, sizeof bmn);
-    memcpy(bmx, mx, sizeof bmx);
-    make_parts(t, 0, bmn, bmx, prm->part_depth);
     return 0;
 }
 
@@ -330,7 +285,6 @@ void cdl_skd_free(cdl_skd *t)
 {
     free(t->nodes);
     free(t->order);
-    free(t->flags);
     free(t->two);
     for (int a = 0; a < 3; a++) {
         free(t->p[a]);
@@ -342,7 +296,7 @@ void cdl_skd_free(cdl_skd *t)
 
 size_t cdl_skd_bytes(const cdl_skd *t)
 {
-    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->n * (4 + 1 + 7 * sizeof(float)) +
+    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->n * (4 + 7 * sizeof(float)) +
            (size_t)t->nparts * sizeof(cdl_skd_part);
 }
 
@@ -568,7 +522,8 @@ int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     for (uint32_t i = lo; i < hi; i++) {
         float z;
         float w = cdl_splat_weight(r, cdl_v3(t->p[0][i], t->p[1][i], t->p[2][i]),
-                                   cdl_v3(t->nrm[0][i], t->nrm[1][i], t->nrm[2][i]), t->flags[i], &z);
+                                   cdl_v3(t->nrm[0][i], t->nrm[1][i], t->nrm[2][i]),
+                                   t->two[i] > 0.0f ? CDL_SKD_TWO_SIDED : 0, &z);
         if (w > 0.0f && add_hit(out, i, w, z > 0.0f ? 1.0f / z : 0.0f))
             return -1;
     }

@@ -38,7 +38,6 @@ typedef struct cdl_skd {
     uint32_t n;
     uint32_t *order; /* caller's index of the sample at each tree position */
     float *p[3], *nrm[3];
-    uint8_t *flags;
     float *two; /* 1 for a two-sided sample, else 0 (the leaf test's arithmetic) */
     float bmin[3], bmax[3];
     cdl_skd_part *parts;

@@ -10,7 +10,29 @@
 #define M0 6.812920690579612   /* 10^(5/6) */
 #define A_MU 0.2
 
-/* p~ of every vertex of a traced path (eq. 4.8); 0 where it is undefined. */
+/* p~ of the vertex after x_from (eq. 4.8) when x_from sampled direction d
+ * (length dlen) with solid-angle density psa, the segment's squared length
+ * d2: x_from's density per projected solid angle (a Dirac after a
+ * specular bounce counts as CDL_PRAY_DELTA_PDF) times p~(x_from), or x_0's
+ * position density, over max(D~^2, d2). 0 where it is undefined. */
+static double next_density(const cdl_vertex_store *vs, const double *pt, uint32_t from, cdl_vec3 d, double dlen,
+                           double psa, double d2, double d2c)
+{
+    double perp;
+    if (vs->flags[from] & CDL_V_DELTA) {
+        perp = CDL_PRAY_DELTA_PDF;
+    } else {
+        int point = from == 0 && (vs->flags[0] & CDL_V_DELTA_LIGHT);
+        cdl_vec3 n = from == 0 ? vs->ng[0] : vs->ns[from];
+        double c = point ? 1.0 : fabs(cdl_dot(n, d)) / dlen;
+        perp = psa / fmax(c, 1e-6);
+    }
+    double prev = from == 0 ? vs->pdf_fwd[0] : pt[from];
+    double p = prev * perp / fmax(d2c, d2);
+    return isfinite(p) ? p : 0.0;
+}
+
+/* p~ of every vertex of a traced path; 0 where it is undefined. */
 static void path_density(const cdl_vertex_store *vs, uint32_t nv, float d2c, double *pt)
 {
     pt[0] = 0.0;
@@ -20,24 +42,20 @@ static void path_density(const cdl_vertex_store *vs, uint32_t nv, float d2c, dou
         pt[i] = 0.0;
         if (!(len > 0.0))
             continue;
+        /* the stored area density back to solid angle at x_{i-1} */
         double cos_i = fabs(cdl_dot(vs->ng[i], d)) / len, pf = vs->pdf_fwd[i];
-        double perp;
-        if (vs->flags[i - 1] & CDL_V_DELTA) {
-            perp = CDL_PRAY_DELTA_PDF;
-        } else {
-            if (!(pf > 0.0 && cos_i > 1e-6))
-                continue;
-            double psa = pf * d2 / cos_i;
-            int point = i == 1 && (vs->flags[0] & CDL_V_DELTA_LIGHT);
-            cdl_vec3 n = i == 1 ? vs->ng[0] : vs->ns[i - 1];
-            double c = point ? 1.0 : fabs(cdl_dot(n, d)) / len;
-            perp = psa / fmax(c, 1e-6);
-        }
-        double prev = i == 1 ? vs->pdf_fwd[0] : pt[i - 1];
-        pt[i] = prev * perp / fmax(d2c, d2);
-        if (!isfinite(pt[i]))
-            pt[i] = 0.0;
+        int delta = (vs->flags[i - 1] & CDL_V_DELTA) != 0;
+        if (!delta && !(pf > 0.0 && cos_i > 1e-6))
+            continue;
+        pt[i] = next_density(vs, pt, i - 1, d, len, delta ? 0.0 : pf * d2 / cos_i, d2, d2c);
     }
+}
+
+/* The budget of the ray ending at x_v: direct (from the light), caustic
+ * (every bounce before it specular) or indirect. */
+static int category(uint32_t v, int all_specular)
+{
+    return v == 1 ? CDL_PRAY_DIRECT : all_specular ? CDL_PRAY_CAUSTIC : CDL_PRAY_INDIRECT;
 }
 
 typedef struct ray_buf {
@@ -159,7 +177,7 @@ static void trace_path(const trace_ctx *cx, uint64_t i, uint32_t off, cdl_vertex
     for (uint32_t v = 1; v < nv; v++) {
         cdl_vec3 d = cdl_sub(vs->p[v], vs->p[v - 1]);
         float len = cdl_length(d);
-        int cat = v == 1 ? CDL_PRAY_DIRECT : all_specular ? CDL_PRAY_CAUSTIC : CDL_PRAY_INDIRECT;
+        int cat = category(v, all_specular);
         if (!(vs->flags[v] & CDL_V_DELTA))
             all_specular = 0; /* for the next ray: x_v scattered it */
         if (!(len > 0.0f) || vs->depth[v] > cx->walk->maxdepth)
@@ -173,19 +191,9 @@ static void trace_path(const trace_ctx *cx, uint64_t i, uint32_t off, cdl_vertex
         return;
     const cdl_scene *s = cx->s;
     float len = exit_distance(vs->p[last], esc.d, s->bmin, s->bmax, 1e-6f);
-    double perp;
-    if (vs->flags[last] & CDL_V_DELTA) {
-        perp = CDL_PRAY_DELTA_PDF;
-    } else {
-        int point = last == 0 && (vs->flags[0] & CDL_V_DELTA_LIGHT);
-        cdl_vec3 n = last == 0 ? vs->ng[0] : vs->ns[last];
-        double c = point ? 1.0 : fabs(cdl_dot(n, esc.d));
-        perp = esc.pdf_dir / fmax(c, 1e-6);
-    }
-    double prev = last == 0 ? vs->pdf_fwd[0] : pt[last];
-    double p = prev * perp / fmax(cx->d2c, (double)len * len);
-    int cat = last == 0 ? CDL_PRAY_DIRECT : all_specular ? CDL_PRAY_CAUSTIC : CDL_PRAY_INDIRECT;
-    add_ray(cx, vs, last + 1, esc.d, len, esc.beta, isfinite(p) ? p : 0.0, cat, &h_prev, off, b);
+    double p = next_density(vs, pt, last, esc.d, 1.0, esc.pdf_dir, (double)len * len, cx->d2c);
+    int cat = category(last + 1, all_specular);
+    add_ray(cx, vs, last + 1, esc.d, len, esc.beta, p, cat, &h_prev, off, b);
 }
 
 /* Paths [first, first + n) in chunks of CHUNK on all threads. */
