@@ -189,21 +189,16 @@ static int build(splat_state *s, cdl_error *err)
     cdl_skd_free(&s->tree);
     if (cdl_skd_build(&s->tree, s->sp, s->sn, s->sflags, s->neye, &s->kp, err))
         return err->code;
-    if (!s->eye) {
-        s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1));
-        s->map = malloc(sizeof(float) * 3 * s->K * (s->nslots ? s->nslots : 1));
-        s->splat_img = malloc(sizeof(float) * SPLAT_IMG * (s->nslots ? s->nslots : 1));
-        if (!s->eye || !s->map || !s->splat_img)
-            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
-    }
+    if (!s->eye && !(s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1))))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the eye samples");
     for (uint32_t q = 0; q < s->neye; q++)
         s->eye[q] = s->slot[s->tree.order[q]];
-    return 0;
+    return splat_maps_alloc(s, err);
 }
 
 static size_t bytes(const splat_state *s)
 {
-    return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2 + (3 * s->K + 2) * sizeof(float)) +
+    return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
            cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
 }
@@ -212,6 +207,8 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
 {
     splat_state *s = self;
     double t0 = cdl_time_now();
+    int a_bw = cdl_film_find_aov(film, "bandwidth");
+    s->want_bw = a_bw >= 0;
     int rc = eye_pass(s, pass, &film->rays, err);
     double t1 = cdl_time_now();
     s->st.t_ray += t1 - t0;
@@ -219,8 +216,6 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
         rc = build(s, err);
     double t2 = cdl_time_now();
     s->st.t_build += t2 - t1;
-    int a_bw = cdl_film_find_aov(film, "bandwidth");
-    s->want_bw = a_bw >= 0;
     if (rc || cdl_cancel)
         return rc;
     if (!s->have_pilot) {
@@ -260,7 +255,7 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
         for (uint32_t q = 0; q < s->neye; q++)
             for (int k = 0; k < 6; k++)
-                acc[6 * (size_t)s->eye[q].pixel + k] += s->splat_img[(size_t)q * SPLAT_IMG + 2 + k];
+                acc[6 * (size_t)s->eye[q].pixel + k] += s->bw[(size_t)q * SPLAT_BW + k];
         for (size_t p = 0; p < npix; p++)
             for (int c = 0; c < 3; c++) {
                 double w = acc[6 * p + 2 * c + 1];
@@ -319,8 +314,13 @@ static void splat_destroy(void *self)
     free(s->eye);
     free(s->base);
     free(s->pix);
-    free(s->map);
-    free(s->splat_img);
+    for (int c = 0; c < 3; c++)
+        free(s->E[c]);
+    free(s->wsum);
+    free(s->izsum);
+    free(s->gloss);
+    free(s->gmap);
+    free(s->bw);
     free(s->tables);
 }
 

@@ -12,7 +12,8 @@
 #include "transport/photon_rays.h"
 
 #define SPLAT_STRATA 20 /* icosahedron faces */
-#define SPLAT_IMG 8
+#define SPLAT_BW 6       /* --aov bandwidth: weighted bandwidth and weight at depth 2, 3, any */
+#define SPLAT_LAMBERT UINT32_MAX
 
 /* An eye sample (§3): what the final step needs besides the tree's
  * position and normal. */
@@ -46,11 +47,18 @@ typedef struct splat_state {
     cdl_vec3 *pix;    /* per pixel: this pass's image */
     cdl_skd tree;
     cdl_skd_params kp;
-    float *map;       /* per eye sample: K x 3 floats */
+    /* Per eye sample in tree order (16 floats of padding: the leaf loop
+     * runs 16 lanes): irradiance E (RGB, one array per channel), the sum
+     * of kernel weights and of 1 / z (for filtering and caching). A
+     * Lambertian sample needs nothing else in any mode (its BSDF is one
+     * constant: kd / pi E; its SH table holds only the DC term); the others
+     * (gloss[q] != SPLAT_LAMBERT) get K x 3 floats in gmap. */
+    float *E[3], *wsum, *izsum;
+    uint32_t *gloss;  /* index into gmap, or SPLAT_LAMBERT */
+    float *gmap;      /* histogram: [stratum][glossy sample][3]; SH: [glossy sample][k][3]; direct: [g][3] */
+    uint32_t nglossy, gcap;
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
-    float *splat_img; /* per eye sample, SPLAT_IMG floats: kernel weight sum, sum of 1 / z (for
-                       * filtering and caching); with --aov bandwidth the weighted bandwidth
-                       * and weight of rays ending at depth 2, 3 and any depth */
+    float *bw;        /* --aov bandwidth only: SPLAT_BW floats per sample */
     int want_bw;
     cdl_vec3 strata[SPLAT_STRATA];
     cdl_sh_rot rot;
@@ -60,6 +68,9 @@ typedef struct splat_state {
 
 /* Radiance-map setup of the mode (strata, SH tables); 0 or an error. */
 int splat_maps_init(splat_state *s, cdl_error *err);
+/* Sizes the maps for this pass's eye samples (after the tree is built). */
+int splat_maps_alloc(splat_state *s, cdl_error *err);
+size_t splat_maps_bytes(const splat_state *s);
 /* Splats every photon ray into the maps, part by part on all threads. */
 void splat_maps_splat(splat_state *s);
 /* Each eye sample's reflected radiance, weighted, into s->pix. */

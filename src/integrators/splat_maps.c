@@ -41,14 +41,14 @@ static void icosahedron(cdl_vec3 *c)
             }
 }
 
-/* RGB of entry k (stratum or coefficient) of sample q: the histogram is
- * stored as one image per stratum (a ray's splats all go to its stratum:
- * neighbouring samples, neighbouring entries), SH per sample (a splat
- * writes all 16). */
-static inline float *map_at(const splat_state *s, uint32_t q, int k)
+/* RGB of entry k (stratum or coefficient) of glossy sample g: the
+ * histogram is stored as one image per stratum (a ray's splats all go to
+ * its stratum: neighbouring samples, neighbouring entries), SH per sample
+ * (a splat writes all 16). */
+static inline float *gmap_at(const splat_state *s, uint32_t g, int k)
 {
-    size_t i = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? (size_t)k * s->neye + q : (size_t)q * s->K + (size_t)k;
-    return &s->map[3 * i];
+    size_t i = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? (size_t)k * s->nglossy + g : (size_t)g * s->K + (size_t)k;
+    return &s->gmap[3 * i];
 }
 
 static int stratum(const splat_state *s, cdl_vec3 w)
@@ -84,8 +84,49 @@ int splat_maps_init(splat_state *s, cdl_error *err)
     return 0;
 }
 
+int splat_maps_alloc(splat_state *s, cdl_error *err)
+{
+    size_t n = (size_t)s->nslots + 16;
+    if (!s->wsum) {
+        for (int c = 0; c < 3; c++)
+            s->E[c] = malloc(sizeof(float) * n);
+        s->wsum = malloc(sizeof(float) * n);
+        s->izsum = malloc(sizeof(float) * n);
+        s->gloss = malloc(sizeof(uint32_t) * n);
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->gloss)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
+    }
+    uint32_t ng = 0;
+    for (uint32_t q = 0; q < s->neye; q++)
+        s->gloss[q] = s->eye[q].b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : ng++;
+    for (uint32_t q = s->neye; q < s->neye + 16; q++)
+        s->gloss[q] = SPLAT_LAMBERT;
+    s->nglossy = ng;
+    if (ng > s->gcap || !s->gmap) {
+        free(s->gmap);
+        s->gcap = ng > s->gcap ? ng + ng / 8 : s->gcap;
+        s->gmap = malloc(sizeof(float) * 3 * s->K * (s->gcap ? s->gcap : 1));
+        if (!s->gmap)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
+    }
+    if (s->want_bw && !s->bw) {
+        s->bw = malloc(sizeof(float) * SPLAT_BW * n);
+        if (!s->bw)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
+    }
+    return 0;
+}
+
+size_t splat_maps_bytes(const splat_state *s)
+{
+    size_t n = s->wsum ? (size_t)s->nslots + 16 : 0;
+    return n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+           (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
+}
+
 /* What one ray adds per unit of kernel weight, computed once per ray and
- * part: RGB per SH coefficient, or the ray's stratum. */
+ * part, on the first glossy sample it meets: RGB per SH coefficient, or
+ * the ray's stratum. */
 typedef struct ray_ctx {
     splat_state *s;
     const cdl_photon_ray *r;
@@ -113,59 +154,101 @@ static void ray_terms(ray_ctx *c)
     }
 }
 
-/* A batch of samples from the tree: the feasible ones get the ray's light. */
-static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz)
+/* The feasible glossy samples of a batch: the ray's light in their maps. */
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, const float *w)
 {
-    ray_ctx *c = ctx;
     splat_state *s = c->s;
     if (!c->ready)
         ray_terms(c);
     const int mode = s->opt.splat.mode;
     const cdl_vec3 flux = c->r->flux;
     for (uint32_t i = 0; i < m; i++) {
-        if (!(w[i] > 0.0f))
+        uint32_t q = first + i, g = s->gloss[q];
+        if (!(w[i] > 0.0f) || g == SPLAT_LAMBERT)
             continue;
-        uint32_t q = first + i;
-        float wi = w[i], *mp = map_at(s, q, mode == CDL_SPLAT_HISTOGRAM ? c->stratum : 0);
-        c->splats++;
+        float wi = w[i];
         if (mode == CDL_SPLAT_SH) {
+            float *mp = gmap_at(s, g, 0);
             for (int k = 0; k < CDL_SH_N * 3; k++)
                 mp[k] += wi * c->sh[k];
         } else if (mode == CDL_SPLAT_HISTOGRAM) {
+            float *mp = gmap_at(s, g, c->stratum);
             mp[0] += wi * flux.x;
             mp[1] += wi * flux.y;
             mp[2] += wi * flux.z;
         } else {
             const splat_eye *ey = &s->eye[q];
-            cdl_vec3 f = ey->b.type == CDL_MAT_DIFFUSE ? cdl_scale(ey->b.kd, (float)CDL_INV_PI)
-                                                       : cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
+            cdl_vec3 f = cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
+            float *mp = gmap_at(s, g, 0);
             mp[0] += wi * f.x * flux.x;
             mp[1] += wi * f.y * flux.y;
             mp[2] += wi * f.z * flux.z;
         }
-        float *si = &s->splat_img[(size_t)q * SPLAT_IMG];
-        si[0] += wi;
-        si[1] += iz[i];
-        if (s->want_bw) {
-            const cdl_photon_ray *r = c->r;
-            float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
-            float h = r->h0 + r->dh * (z < r->len ? z : r->len);
-            int d = r->depth == 2 ? 0 : r->depth == 3 ? 1 : -1;
-            if (d >= 0) {
-                si[2 + 2 * d] += wi * h;
-                si[3 + 2 * d] += wi;
-            }
-            si[6] += wi * h;
-            si[7] += wi;
-        }
     }
+}
+
+/* --aov bandwidth: the kernel-weighted bandwidth of the rays per sample. */
+static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, const float *w, const float *iz)
+{
+    const cdl_photon_ray *r = c->r;
+    for (uint32_t i = 0; i < m; i++) {
+        if (!(w[i] > 0.0f))
+            continue;
+        float *b = &c->s->bw[(size_t)(first + i) * SPLAT_BW];
+        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
+        float h = r->h0 + r->dh * (z < r->len ? z : r->len);
+        int d = r->depth == 2 ? 0 : r->depth == 3 ? 1 : -1;
+        if (d >= 0) {
+            b[2 * d] += w[i] * h;
+            b[2 * d + 1] += w[i];
+        }
+        b[4] += w[i] * h;
+        b[5] += w[i];
+    }
+}
+
+/* A batch of samples from the tree: every feasible one gets the ray's
+ * irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
+ * perhaps another thread's: masked); glossy ones their map entries too. */
+static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz)
+{
+    ray_ctx *c = ctx;
+    splat_state *s = c->s;
+    const float fr = c->r->flux.x, fg = c->r->flux.y, fb = c->r->flux.z;
+    float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
+    float *ws = s->wsum + first, *zs = s->izsum + first;
+    const uint32_t *gl = s->gloss + first;
+    uint32_t hits = 0, glossy = 0;
+#pragma omp simd reduction(+ : hits) reduction(| : glossy)
+    for (uint32_t i = 0; i < 16; i++) {
+        uint32_t on = w[i] > 0.0f;
+        if (i < m) {
+            er[i] += w[i] * fr;
+            eg[i] += w[i] * fg;
+            eb[i] += w[i] * fb;
+            ws[i] += w[i];
+            zs[i] += on ? iz[i] : 0.0f;
+        }
+        hits += on;
+        glossy |= on & (gl[i] != SPLAT_LAMBERT);
+    }
+    c->splats += hits;
+    if (glossy)
+        splat_glossy(c, first, m, w);
+    if (s->want_bw)
+        splat_bandwidth(c, first, m, w, iz);
 }
 
 void splat_maps_splat(splat_state *s)
 {
-    size_t n = (size_t)s->neye * s->K * 3;
-    memset(s->map, 0, sizeof(float) * (n ? n : 1));
-    memset(s->splat_img, 0, sizeof(float) * SPLAT_IMG * (s->neye ? s->neye : 1));
+    size_t n = (size_t)s->neye + 16;
+    for (int c = 0; c < 3; c++)
+        memset(s->E[c], 0, sizeof(float) * n);
+    memset(s->wsum, 0, sizeof(float) * n);
+    memset(s->izsum, 0, sizeof(float) * n);
+    memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
+    if (s->want_bw)
+        memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
     uint64_t splats = 0, tested = 0, nodes = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
     for (uint32_t part = 0; part < s->tree.nparts; part++) {
@@ -205,31 +288,26 @@ void splat_maps_resolve(splat_state *s)
 #pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++) {
         const splat_eye *e = &s->eye[q];
-        const int lambert = e->b.type == CDL_MAT_DIFFUSE;
-        const float *m = map_at(s, q, 0);
+        const uint32_t g = s->gloss[q];
         cdl_vec3 L;
-        if (mode == CDL_SPLAT_DIRECT) {
+        if (g == SPLAT_LAMBERT) {
+            L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
+        } else if (mode == CDL_SPLAT_DIRECT) {
+            const float *m = gmap_at(s, g, 0);
             L = cdl_v3(m[0], m[1], m[2]);
         } else if (mode == CDL_SPLAT_HISTOGRAM) {
-            cdl_vec3 E = cdl_v3(0.0f, 0.0f, 0.0f);
-            L = E;
+            L = cdl_v3(0.0f, 0.0f, 0.0f);
             for (int k = 0; k < SPLAT_STRATA; k++) {
-                const float *mk = map_at(s, q, k);
+                const float *mk = gmap_at(s, g, k);
                 cdl_vec3 Ek = cdl_v3(mk[0], mk[1], mk[2]);
                 if (cdl_is_black(Ek))
                     continue;
-                if (lambert) {
-                    E = cdl_add(E, Ek);
-                    continue;
-                }
                 cdl_vec3 wi = above(s->strata[k], e->f.n);
                 L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&e->b, e->wo, wi, 0), Ek));
             }
-            if (lambert)
-                L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), E);
         } else {
             float loc[CDL_SH_N * 3], c[CDL_SH_N * 3];
-            cdl_sh_rotate(&s->rot, e->f, m, loc, 3);
+            cdl_sh_rotate(&s->rot, e->f, gmap_at(s, g, 0), loc, 3);
             cdl_bsdf_sh_lookup(&s->tables[e->mat], cdl_dot(e->wo, e->f.n), e->b.kd, c);
             float acc[3] = {0.0f, 0.0f, 0.0f};
             for (int k = 0; k < CDL_SH_N; k++)
@@ -239,15 +317,14 @@ void splat_maps_resolve(splat_state *s)
         }
         L = cdl_mul(L, e->weight);
         /* pixels take their samples in tree order: one pixel's samples may
-         * sit in different parts, so this sum runs after the parallel loop */
-        float *out = map_at(s, q, 0);
-        out[0] = L.x;
-        out[1] = L.y;
-        out[2] = L.z;
+         * sit in different parts, so this sum runs after the parallel loop;
+         * E holds the sample's radiance until then */
+        s->E[0][q] = L.x;
+        s->E[1][q] = L.y;
+        s->E[2][q] = L.z;
     }
     for (uint32_t q = 0; q < s->neye; q++) {
-        const float *m = map_at(s, q, 0);
         uint32_t p = s->eye[q].pixel;
-        s->pix[p] = cdl_add(s->pix[p], cdl_v3(m[0], m[1], m[2]));
+        s->pix[p] = cdl_add(s->pix[p], cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
     }
 }

@@ -343,17 +343,19 @@ static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ra
         float h2 = h * h, beyond = z - len;
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f);
         if (plane) {
-            float tp = (Dx * nx[i] + Dy * ny[i] + Dz * nz[i]) / dn;
+            /* the distance tp = (D . n) / dn to the sample's tangent plane
+             * against X, without the division: dn < 0 flips the test */
+            float dpn = Dx * nx[i] + Dy * ny[i] + Dz * nz[i], X = len * 1.0001f + 1e-3f * h;
+            int reached = ((dn < 0.0f) & (dpn >= X * dn)) | ((dn >= 0.0f) & (dpn <= X * dn));
             /* reached the sample's tangent plane, or ended within h of the
              * sample (a neighbouring surface of a concave corner) */
-            ok &= (beyond <= 0.0f) | ((beyond <= cap * h) & ((tp <= len * 1.0001f + 1e-3f * h) |
-                                                             (r2 + beyond * beyond < h2)));
+            ok &= (beyond <= 0.0f) | ((beyond <= cap * h) & (reached | (r2 + beyond * beyond < h2)));
         } else {
             h2 -= beyond > 0.0f ? beyond * beyond : 0.0f;
         }
         ok &= (h2 > 0.0f) & (r2 < h2) & (i < m);
         float rr = r2 > 0.0f ? r2 : 0.0f;
-        float wi = norm / h2 * (1.0f - rr / h2) * -c;
+        float wi = norm * (h2 - rr) * -c / (h2 * h2);
         w[i] = ok ? wi : 0.0f;
         zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
