@@ -18,20 +18,4 @@ uint32_t cdl_oct_encode_bits(cdl_vec3 d, int bits)
     return a << bits | b;
 }
 
-cdl_vec3 cdl_oct_decode_raw(uint32_t e, int bits)
-{
-    uint32_t mask = (1u << bits) - 1u;
-    float m = (float)mask;
-    float u = (float)((e >> bits) & mask) / m * 2.0f - 1.0f;
-    float v = (float)(e & mask) / m * 2.0f - 1.0f;
-    float z = 1.0f - fabsf(u) - fabsf(v);
-    if (z < 0.0f) {
-        float pu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        float pv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-        u = pu;
-        v = pv;
-    }
-    return cdl_v3(u, v, z);
-}
-
 cdl_vec3 cdl_oct_decode_bits(uint32_t e, int bits) { return cdl_normalize(cdl_oct_decode_raw(e, bits)); }

@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "core/log.h"
+#include "core/morton.h"
 #include "integrators/gkde.h"
 
 #define LIGHT_CHUNK 1024
@@ -214,16 +215,6 @@ static int trace_lights(gkde_state *s, uint32_t pass, uint64_t *rays, cdl_error 
 /* Footprint radii (eq. 7) for bandwidth h, and the light vertices that
  * can link: x_k past the start whose parent is not specular, with a
  * bounce left for the eye path. */
-/* 10 bits of x spread to every third bit. */
-static uint64_t spread3(uint32_t x)
-{
-    uint64_t v = x & 0x3ff;
-    v = (v | v << 16) & 0x30000ff;
-    v = (v | v << 8) & 0x300f00f;
-    v = (v | v << 4) & 0x30c30c3;
-    return (v | v << 2) & 0x9249249;
-}
-
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -253,10 +244,7 @@ static int sort_spatially(gkde_state *s, cdl_error *err)
 #pragma omp parallel for schedule(static)
     for (uint32_t a = 0; a < n; a++) {
         const float *p = &l->p[s->lv[a]].x;
-        uint64_t m = 0;
-        for (int k = 0; k < 3; k++)
-            m |= spread3((uint32_t)((p[k] - lo[k]) * sc)) << k;
-        key[a] = m << 32 | s->lv[a];
+        key[a] = cdl_morton3(p, lo, sc) << 32 | s->lv[a];
     }
     qsort(key, n, sizeof *key, cmp_u64);
     for (uint32_t a = 0; a < n; a++)

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "core/log.h"
+#include "core/morton.h"
 #include "transport/light_select.h"
 #include "transport/visible.h"
 
@@ -196,6 +197,52 @@ static int build(splat_state *s, cdl_error *err)
     return splat_maps_alloc(s, err);
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The rays put in Morton order of their ends (the report's presorting of
+ * photon rays): consecutive rays meet the same nodes and eye samples, so
+ * the traversal's branches repeat and the samples stay in cache. */
+static int sort_rays(splat_state *s, cdl_error *err)
+{
+    uint32_t n = s->rays.n;
+    uint64_t *key = malloc(sizeof *key * (n ? n : 1));
+    if (!key)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for %u photon rays", n);
+    const float *lo = &s->scene->bmin.x, *hi = &s->scene->bmax.x;
+    float ext = cdl_maxf(hi[0] - lo[0], cdl_maxf(hi[1] - lo[1], hi[2] - lo[2]));
+    float sc = ext > 0.0f ? 1023.0f / ext : 0.0f;
+    cdl_photon_ray *r = s->rays.r;
+#pragma omp parallel for schedule(static)
+    for (uint32_t k = 0; k < n; k++) {
+        cdl_vec3 e = cdl_add(r[k].o, cdl_scale(r[k].d, r[k].len));
+        key[k] = cdl_morton3(&e.x, lo, sc) << 32 | k;
+    }
+    qsort(key, n, sizeof *key, cmp_u64);
+    /* in place, cycle by cycle: position k takes ray key[k]; a done
+     * position is marked by its key's index set to k */
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t src = (uint32_t)key[k];
+        if (src == k)
+            continue;
+        cdl_photon_ray tmp = r[k];
+        uint32_t j = k;
+        while (src != k) {
+            r[j] = r[src];
+            key[j] = (key[j] & ~(uint64_t)UINT32_MAX) | j;
+            j = src;
+            src = (uint32_t)key[j];
+        }
+        r[j] = tmp;
+        key[j] = (key[j] & ~(uint64_t)UINT32_MAX) | j;
+    }
+    free(key);
+    return 0;
+}
+
 static size_t bytes(const splat_state *s)
 {
     return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
@@ -227,6 +274,9 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     }
     s->pp.m_scale = (double)pass + 1.0;
     rc = cdl_pray_trace(s->scene, &s->walk, &s->pp, s->opt.sampler, s->opt.seed, pass, &s->rays, err);
+    if (rc)
+        return rc;
+    rc = sort_rays(s, err);
     if (rc)
         return rc;
     film->rays += s->rays.rays;

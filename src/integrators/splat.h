@@ -37,7 +37,7 @@ typedef struct splat_state {
     cdl_walk walk;
     cdl_pray_params pp;
     int have_pilot;
-    cdl_pray_set rays;
+    cdl_pray_set rays; /* in Morton order of their ends */
     /* eye samples: slots per pixel sample while tracing, then tree order */
     cdl_vec3 *sp, *sn;
     uint8_t *sflags, *svalid;

@@ -15,6 +15,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "integrators/splat.h"
 
@@ -155,7 +158,7 @@ static void ray_terms(ray_ctx *c)
 }
 
 /* The feasible glossy samples of a batch: the ray's light in their maps. */
-static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, const float *w)
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w)
 {
     splat_state *s = c->s;
     if (!c->ready)
@@ -164,7 +167,7 @@ static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, const float *w)
     const cdl_vec3 flux = c->r->flux;
     for (uint32_t i = 0; i < m; i++) {
         uint32_t q = first + i, g = s->gloss[q];
-        if (!(w[i] > 0.0f) || g == SPLAT_LAMBERT)
+        if (!(mask >> i & 1u) || g == SPLAT_LAMBERT)
             continue;
         float wi = w[i];
         if (mode == CDL_SPLAT_SH) {
@@ -188,11 +191,11 @@ static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, const float *w)
 }
 
 /* --aov bandwidth: the kernel-weighted bandwidth of the rays per sample. */
-static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, const float *w, const float *iz)
+static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
 {
     const cdl_photon_ray *r = c->r;
     for (uint32_t i = 0; i < m; i++) {
-        if (!(w[i] > 0.0f))
+        if (!(mask >> i & 1u))
             continue;
         float *b = &c->s->bw[(size_t)(first + i) * SPLAT_BW];
         float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
@@ -210,33 +213,42 @@ static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, const float 
 /* A batch of samples from the tree: every feasible one gets the ray's
  * irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
  * perhaps another thread's: masked); glossy ones their map entries too. */
-static void splat_batch(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz)
+static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
 {
     ray_ctx *c = ctx;
     splat_state *s = c->s;
-    const float fr = c->r->flux.x, fg = c->r->flux.y, fb = c->r->flux.z;
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
     float *ws = s->wsum + first, *zs = s->izsum + first;
     const uint32_t *gl = s->gloss + first;
-    uint32_t hits = 0, glossy = 0;
-#pragma omp simd reduction(+ : hits) reduction(| : glossy)
-    for (uint32_t i = 0; i < 16; i++) {
-        uint32_t on = w[i] > 0.0f;
-        if (i < m) {
-            er[i] += w[i] * fr;
-            eg[i] += w[i] * fg;
-            eb[i] += w[i] * fb;
-            ws[i] += w[i];
-            zs[i] += on ? iz[i] : 0.0f;
-        }
-        hits += on;
-        glossy |= on & (gl[i] != SPLAT_LAMBERT);
+#if defined(__AVX512F__)
+    const __mmask16 k = (__mmask16)mask;
+    const __m512 wv = _mm512_loadu_ps(w);
+    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.x), _mm512_maskz_loadu_ps(k, er)));
+    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.y), _mm512_maskz_loadu_ps(k, eg)));
+    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
+    _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
+    uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
+    c->splats += (uint64_t)__builtin_popcount(mask);
+#else
+    const float fr = c->r->flux.x, fg = c->r->flux.y, fb = c->r->flux.z;
+    uint32_t glossy = 0;
+    for (uint32_t i = 0; i < m; i++) {
+        if (!(mask >> i & 1u))
+            continue;
+        er[i] += w[i] * fr;
+        eg[i] += w[i] * fg;
+        eb[i] += w[i] * fb;
+        ws[i] += w[i];
+        zs[i] += iz[i];
+        glossy |= gl[i] != SPLAT_LAMBERT;
+        c->splats++;
     }
-    c->splats += hits;
+#endif
     if (glossy)
-        splat_glossy(c, first, m, w);
+        splat_glossy(c, first, m, mask, w);
     if (s->want_bw)
-        splat_bandwidth(c, first, m, w, iz);
+        splat_bandwidth(c, first, m, mask, w, iz);
 }
 
 void splat_maps_splat(splat_state *s)

@@ -3,6 +3,9 @@
 #include "core/octahedral.h"
 
 #include <math.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -216,6 +219,54 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
     mn[axis] = keep;
 }
 
+/* The bounding sphere of every node below `node` (lsph: centre and
+ * radius; an empty subtree gets radius -1), the box of its samples into
+ * lo, hi (empty: lo > hi). Returns the node after the subtree. */
+static uint32_t spheres(cdl_skd *t, uint32_t node, float *lo, float *hi)
+{
+    cdl_skd_node nd = t->nodes[node];
+    float *sp = t->lsph + 4 * (size_t)node;
+    uint32_t next;
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+    }
+    if ((nd.b & 3) == 3 && ((nd.b >> 2) & 3) == KIND_LEAF) {
+        uint32_t l = nd.b >> 4, h = l + nd.a;
+        for (int a = 0; a < 3; a++)
+            for (uint32_t i = l; i < h; i++) {
+                lo[a] = t->p[a][i] < lo[a] ? t->p[a][i] : lo[a];
+                hi[a] = t->p[a][i] > hi[a] ? t->p[a][i] : hi[a];
+            }
+        next = node + 1;
+    } else if ((nd.b & 3) == 3 && ((nd.b >> 2) & 3) == KIND_EMPTY) {
+        next = node + 1;
+    } else if ((nd.b & 3) == 3) { /* culling node: its child's samples */
+        next = spheres(t, node + 1, lo, hi);
+    } else {
+        float l2[3], h2[3];
+        spheres(t, node + 1, lo, hi);
+        next = spheres(t, nd.b >> 2, l2, h2);
+        for (int a = 0; a < 3; a++) {
+            lo[a] = l2[a] < lo[a] ? l2[a] : lo[a];
+            hi[a] = h2[a] > hi[a] ? h2[a] : hi[a];
+        }
+    }
+    if (!(lo[0] <= hi[0])) {
+        sp[0] = sp[1] = sp[2] = 0.0f;
+        sp[3] = -1.0f;
+        return next;
+    }
+    float r2 = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        sp[a] = 0.5f * (lo[a] + hi[a]);
+        r2 += 0.25f * (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    /* a little larger: the samples' distances are computed in float too */
+    sp[3] = sqrtf(r2) * 1.0001f + 1e-6f * (fabsf(sp[0]) + fabsf(sp[1]) + fabsf(sp[2]));
+    return next;
+}
+
 int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_t *flags, uint32_t n_samples,
                   const cdl_skd_params *prm, cdl_error *err)
 {
@@ -278,6 +329,16 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
         }
         t->two[i] = flags && (flags[s] & CDL_SKD_TWO_SIDED) ? 1.0f : 0.0f;
     }
+    /* every node's bounding sphere */
+    t->lsph = malloc(sizeof(float) * 4 * (t->nnodes ? t->nnodes : 1));
+    if (!t->lsph) {
+        cdl_skd_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
+    }
+    if (t->nnodes) {
+        float bl[3], bh[3];
+        spheres(t, 0, bl, bh);
+    }
     return 0;
 }
 
@@ -291,12 +352,13 @@ void cdl_skd_free(cdl_skd *t)
         free(t->nrm[a]);
     }
     free(t->parts);
+    free(t->lsph);
     memset(t, 0, sizeof *t);
 }
 
 size_t cdl_skd_bytes(const cdl_skd *t)
 {
-    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->n * (4 + 7 * sizeof(float)) +
+    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->nnodes * 4 * sizeof(float) + (size_t)t->n * (4 + 7 * sizeof(float)) +
            (size_t)t->nparts * sizeof(cdl_skd_part);
 }
 
@@ -316,11 +378,82 @@ static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
     return 0;
 }
 
-/* Algorithm 2's feasibility and weight for up to 16 samples from b, with
- * no branch in the loop (it vectorizes; `plane` is a constant in each
- * caller); cdl_splat_weight is the same test one sample at a time. */
-static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
-                           float *zz)
+/* Algorithm 2's feasibility and weight for up to 16 samples from b:
+ * w[i] kernel times cosine (0 where infeasible), zz[i] 1 / z; returns
+ * the mask of feasible lanes. `plane` is a constant in each caller;
+ * cdl_splat_weight is the same test one sample at a time. With AVX-512
+ * the 16 lanes are one register and the reciprocals rcp14 with a Newton
+ * step (relative error ~1e-7); otherwise a branch-free loop that the
+ * compiler vectorizes. */
+#if defined(__AVX512F__)
+static inline __m512 rcp_nr(__m512 x)
+{
+    __m512 r = _mm512_rcp14_ps(x);
+    return _mm512_mul_ps(r, _mm512_fnmadd_ps(x, r, _mm512_set1_ps(2.0f)));
+}
+
+static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane,
+                               float *w, float *zz)
+{
+    const __m512 zero = _mm512_setzero_ps();
+    const __m512 dx = _mm512_set1_ps(r->d.x), dy = _mm512_set1_ps(r->d.y), dz = _mm512_set1_ps(r->d.z);
+    const __m512 len = _mm512_set1_ps(r->len);
+    __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), _mm512_set1_ps(r->o.x));
+    __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), _mm512_set1_ps(r->o.y));
+    __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), _mm512_set1_ps(r->o.z));
+    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
+           nz = _mm512_loadu_ps(t->nrm[2] + b);
+    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
+    /* -|dn| for a two-sided sample */
+    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
+    __m512 z = _mm512_fmadd_ps(Dz, dz, _mm512_fmadd_ps(Dy, dy, _mm512_mul_ps(Dx, dx)));
+    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
+                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
+    /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray would
+     * lose r^2 to cancellation */
+    __m512 ex = _mm512_fnmadd_ps(z, dx, Dx), ey = _mm512_fnmadd_ps(z, dy, Dy), ez = _mm512_fnmadd_ps(z, dz, Dz);
+    __m512 r2 = _mm512_fmadd_ps(ez, ez, _mm512_fmadd_ps(ey, ey, _mm512_mul_ps(ex, ex)));
+    __m512 h = _mm512_fmadd_ps(_mm512_set1_ps(r->dh), _mm512_min_ps(z, len), _mm512_set1_ps(r->h0));
+    __m512 h2 = _mm512_mul_ps(h, h), beyond = _mm512_sub_ps(z, len);
+    __mmask16 ok = (__mmask16)(m >= 16 ? 0xffffu : (1u << m) - 1u);
+    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
+    ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
+    ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
+    if (plane) {
+        /* reached the sample's tangent plane ((D . n) / dn <= X, without
+         * the division), or ended within h of the sample (a neighbouring
+         * surface of a concave corner) */
+        __m512 dpn = _mm512_fmadd_ps(Dz, nz, _mm512_fmadd_ps(Dy, ny, _mm512_mul_ps(Dx, nx)));
+        __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, _mm512_set1_ps(r->len * 1.0001f));
+        __m512 Xdn = _mm512_mul_ps(X, dn);
+        __mmask16 neg = _mm512_cmp_ps_mask(dn, zero, _CMP_LT_OQ);
+        __mmask16 reached = (__mmask16)((neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_GE_OQ)) |
+                                        (~neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_LE_OQ)));
+        __mmask16 sphere = _mm512_cmp_ps_mask(_mm512_fmadd_ps(beyond, beyond, r2), h2, _CMP_LT_OQ);
+        __mmask16 within = _mm512_cmp_ps_mask(beyond, _mm512_mul_ps(_mm512_set1_ps(r->cap), h), _CMP_LE_OQ);
+        __mmask16 before = _mm512_cmp_ps_mask(beyond, zero, _CMP_LE_OQ);
+        ok &= (__mmask16)(before | (within & (reached | sphere)));
+    } else {
+        __m512 bp = _mm512_max_ps(beyond, zero);
+        h2 = _mm512_fnmadd_ps(bp, bp, h2);
+    }
+    ok = _mm512_mask_cmp_ps_mask(ok, h2, zero, _CMP_GT_OQ);
+    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
+    if (!ok)
+        return 0;
+    __m512 ih2 = rcp_nr(h2);
+    /* 1 - r^2 / h^2 >= 0 also where the reciprocal rounds */
+    __m512 k = _mm512_mul_ps(_mm512_max_ps(_mm512_fnmadd_ps(_mm512_max_ps(r2, zero), ih2, _mm512_set1_ps(1.0f)), zero),
+                             ih2);
+    __m512 wv = _mm512_mul_ps(_mm512_mul_ps(k, _mm512_set1_ps((float)(2.0 / CDL_PI))), _mm512_sub_ps(zero, c));
+    _mm512_storeu_ps(w, _mm512_maskz_mov_ps(ok, wv));
+    __mmask16 zpos = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GT_OQ);
+    _mm512_storeu_ps(zz, _mm512_maskz_mov_ps(zpos, rcp_nr(_mm512_mask_mov_ps(_mm512_set1_ps(1.0f), zpos, z))));
+    return ok;
+}
+#else
+static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
+                        float *zz)
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
@@ -359,12 +492,18 @@ static void weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ra
         w[i] = ok ? wi : 0.0f;
         zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
+    uint32_t mask = 0;
+    for (uint32_t i = 0; i < 16; i++)
+        mask |= (uint32_t)(w[i] > 0.0f) << i;
+    return mask;
 }
+#endif
 
 typedef struct trav {
     const cdl_skd *t;
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
+    float zmax;               /* no sample farther along the ray is fed */
     int cull;
     cdl_skd_visit fn;
     void *ctx;
@@ -377,20 +516,29 @@ static void test_range(const trav *v, uint32_t lo, uint32_t hi)
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
-        if (v->r->cap > 0.0f)
-            weigh16(v->t, b, m, v->r, 1, w, zz);
-        else
-            weigh16(v->t, b, m, v->r, 0, w, zz);
-        int any = 0;
-        for (uint32_t i = 0; i < m; i++)
-            any |= w[i] > 0.0f;
+        uint32_t any = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz) : weigh16(v->t, b, m, v->r, 0, w, zz);
         if (any)
-            v->fn(v->ctx, b, m, w, zz);
+            v->fn(v->ctx, b, m, any, w, zz);
     }
 }
 
 /* Radius of the frustum at distance t (the cap keeps the hit's radius). */
 static float radius_at(const cdl_splat_ray *r, float t) { return r->h0 + r->dh * (t < r->len ? t : r->len); }
+
+/* Whether the frustum can reach the node's bounding sphere: the 1D
+ * traversal's boxes reach far past the frustum at oblique incidence. */
+static int sphere_reached(const trav *v, uint32_t node)
+{
+    const float *sp = v->t->lsph + 4 * (size_t)node;
+    const cdl_splat_ray *r = v->r;
+    float Dx = sp[0] - v->o[0], Dy = sp[1] - v->o[1], Dz = sp[2] - v->o[2], rad = sp[3];
+    float z = Dx * v->d[0] + Dy * v->d[1] + Dz * v->d[2];
+    if (z + rad < 0.0f || z - rad > v->zmax)
+        return 0;
+    float ex = Dx - z * v->d[0], ey = Dy - z * v->d[1], ez = Dz - z * v->d[2];
+    float R = radius_at(r, z + rad) + rad;
+    return ex * ex + ey * ey + ez * ez <= R * R;
+}
 
 /* Algorithm 1: node over the ray interval [t0, t1]. */
 static int traverse(const trav *v, uint32_t node, float t0, float t1)
@@ -404,20 +552,26 @@ static int traverse(const trav *v, uint32_t node, float t0, float t1)
             uint32_t kind = (nd.b >> 2) & 3;
             if (kind == KIND_LEAF) {
                 uint32_t lo = nd.b >> 4;
-                test_range(v, lo, lo + nd.a);
+                if (sphere_reached(v, node))
+                    test_range(v, lo, lo + nd.a);
                 return 0;
             }
             if (kind == KIND_EMPTY)
                 return 0;
             /* culling node: every sample faces away from the ray */
             if (v->cull) {
+                /* d . n / |n| >= C_max without normalizing n */
                 float cmax = (float)(nd.b >> 16) / 65535.0f;
-                if (cdl_dot(v->r->d, cdl_oct_decode_bits(nd.a, 16)) >= cmax)
+                cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
+                float dv = cdl_dot(v->r->d, n);
+                if (dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n))
                     return 0;
             }
             node++;
             continue;
         }
+        if (!sphere_reached(v, node))
+            return 0;
         int a = (int)ty;
         float s = bitsf(nd.a), R1 = radius_at(v->r, t1);
         uint32_t left = node + 1, right = nd.b >> 2;
@@ -468,11 +622,12 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         mn = t->parts[part].bmin;
         mx = t->parts[part].bmax;
     }
-    trav v = {t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f}, cull, fn, ctx, cnt};
+    trav v = {t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f}, 0.0f, cull, fn, ctx, cnt};
     for (int a = 0; a < 3; a++)
         v.inv[a] = v.d[a] != 0.0f ? 1.0f / fabsf(v.d[a]) : 0.0f;
     /* clip [0, len + cap h(len)] by the box grown by the largest radius */
     float hmax = radius_at(r, r->len), t0 = 0.0f, t1 = r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax;
+    v.zmax = t1;
     for (int a = 0; a < 3; a++) {
         float lo = mn[a] - hmax, hi = mx[a] + hmax;
         if (v.d[a] == 0.0f) {
@@ -494,11 +649,11 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     return traverse(&v, root, t0, t1);
 }
 
-static void append(void *ctx, uint32_t first, uint32_t m, const float *w, const float *z)
+static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *z)
 {
     cdl_splat_hits *out = ctx;
     for (uint32_t i = 0; i < m; i++)
-        if (w[i] > 0.0f && !out->fail)
+        if ((mask >> i & 1u) && w[i] > 0.0f && !out->fail)
             add_hit(out, first + i, w[i], z[i]);
 }
 

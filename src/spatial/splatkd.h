@@ -39,6 +39,7 @@ typedef struct cdl_skd {
     uint32_t *order; /* caller's index of the sample at each tree position */
     float *p[3], *nrm[3];
     float *two; /* 1 for a two-sided sample, else 0 (the leaf test's arithmetic) */
+    float *lsph; /* per node: a leaf's bounding sphere (centre, radius) */
     float bmin[3], bmax[3];
     cdl_skd_part *parts;
     uint32_t nparts;
@@ -137,9 +138,10 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
- * (m <= 16) of which those with w[i] > 0 are feasible (kernel times
- * cosine; iz[i] one over their distance along the ray, 0 at 0). */
-typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, const float *w, const float *iz);
+ * (m <= 16) of which those in `mask` (bit i: sample first + i; never
+ * past m) are feasible with weight w[i] >= 0 (kernel times cosine; 0
+ * elsewhere) and iz[i] one over their distance along the ray (0 at 0). */
+typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz);
 typedef struct cdl_skd_count {
     uint64_t tested, nodes;
 } cdl_skd_count;
