@@ -150,7 +150,7 @@ static void density(void)
     CHECK(top.n == (uint32_t)(G * G) && top.built, "photon map holds %u photons", top.n);
 
     uint32_t kmax = 400;
-    cdl_pm_query q = {0, 1.0f, CDL_KERNEL_BOX, 0, malloc(sizeof(uint32_t) * kmax), malloc(sizeof(float) * kmax), {0}, 0};
+    cdl_pm_query q = {0, 1.0f, CDL_KERNEL_BOX, 0, malloc(sizeof(uint32_t) * kmax), malloc(sizeof(float) * kmax), {0}, 0, NULL, 0};
     /* k-NN noise: relative sd about 1/sqrt(k) for Poisson photons, less
      * for stratified ones. Measured (mean over 576 points / worst point):
      * k 25: box 2.2 / 23 %, cone 0.76 / 17 %, epanechnikov 0.82 / 19 %;
@@ -274,7 +274,7 @@ static void density(void)
     for (int ev = 0; ev < 2; ev++) {
         cdl_irr_map im;
         memset(&im, 0, sizeof im);
-        die_on(cdl_irr_build(&im, &both_s, &caus, every[ev], &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &both_s, &caus, every[ev], &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err), &err);
         double expect_n = (double)both_s.n / every[ev], sd_n = sqrt(expect_n);
         int nfound = 0;
         double worst_val = 0.0, mean_val = 0.0;
@@ -312,7 +312,7 @@ static void density(void)
     {
         cdl_irr_map im;
         memset(&im, 0, sizeof im);
-        CHECK(cdl_irr_build(&im, &both_s, &caus, 1, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0}, &err) == CDL_ERR_USAGE,
+        CHECK(cdl_irr_build(&im, &both_s, &caus, 1, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err) == CDL_ERR_USAGE,
               "cdl_irr_build with every = 1 is a usage error");
     }
     /* one-sided: the opposite normal (or a perpendicular one) finds nothing */
@@ -322,7 +322,7 @@ static void density(void)
         cdl_photon_map nocaus;
         cdl_pmap_init(&nocaus);
         die_on(cdl_pmap_build(&nocaus, &err), &err);
-        die_on(cdl_irr_build(&im, &top_s, &nocaus, 2, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_BOX, 0, NULL, NULL, novis, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &top_s, &nocaus, 2, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_BOX, 0, NULL, NULL, novis, 0, NULL, 0}, &err), &err);
         int any_down = 0, any_side = 0, all_up = 1;
         for (uint32_t i = 0; i < top_s.n; i += 17) {
             cdl_vec3 x = cdl_v3(top_s.ph[i].p[0], top_s.ph[i].p[1], top_s.ph[i].p[2]);
@@ -383,7 +383,7 @@ static void sparse(void)
         for (int kern = 0; kern < 2; kern++) {
             cdl_irr_map im;
             memset(&im, 0, sizeof im);
-            die_on(cdl_irr_build(&im, &pm, &none, 4, &(cdl_pm_query){50, 0.01f, kern ? CDL_KERNEL_BOX : CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0}, &err),
+            die_on(cdl_irr_build(&im, &pm, &none, 4, &(cdl_pm_query){50, 0.01f, kern ? CDL_KERNEL_BOX : CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err),
                    &err);
             for (int j = 0; j < 16; j++)
                 for (int i = 0; i < 16; i++) {
@@ -397,7 +397,7 @@ static void sparse(void)
                     if (!kern) {
                         /* as pm does it: a point within 0.05, else the photons */
                         E = cdl_irr_lookup(&im, x, up, 0.05f * 0.05f, novis, &found);
-                        cdl_pm_query q = {50, 0.01f, CDL_KERNEL_BOX, 0, qi, qd, novis, 0};
+                        cdl_pm_query q = {50, 0.01f, CDL_KERNEL_BOX, 0, qi, qd, novis, 0, NULL, 0};
                         double Ee = found ? E.y : cdl_pmap_irradiance(&im.est, &q, x, up).y;
                         double Ea = found ? E.y : cdl_pmap_irradiance(&pm, &q, x, up).y;
                         fb_est += Ee / Phi.y;
@@ -455,7 +455,7 @@ static void wall(void)
     die_on(cdl_pmap_build(&none, &err), &err);
     const uint32_t k = 50;
     cdl_pm_query q = {k + 1, 1.0f, CDL_KERNEL_CONE, 0, malloc(sizeof(uint32_t) * (k + 1)),
-                      malloc(sizeof(float) * (k + 1)), vis, 0};
+                      malloc(sizeof(float) * (k + 1)), vis, 0, NULL, 0};
     double worst_vis = 0.0, worst_novis = 0.0, worst_lookup = 0.0, worst_lookup_novis = 0.0;
     int found_all = 1;
     for (int pass = 0; pass < 2; pass++) {
@@ -463,7 +463,7 @@ static void wall(void)
         memset(&im, 0, sizeof im);
         q.vis = pass ? novis : vis;
         q.k = k;
-        die_on(cdl_irr_build(&im, &m, &none, 2, &(cdl_pm_query){k, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, q.vis, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &m, &none, 2, &(cdl_pm_query){k, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, q.vis, 0, NULL, 0}, &err), &err);
         for (int j = 0; j < 40; j++)
             for (int i = 0; i < 20; i++) {
                 cdl_vec3 x = cdl_v3(0.3f + 0.2f * (i + 0.5f) / 20.0f, 0.2f + 0.6f * (j + 0.5f) / 40.0f, 0.0f);

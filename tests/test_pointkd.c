@@ -53,9 +53,9 @@ static void run(const char *name, int kind, uint32_t n)
     die_on(cdl_kd_build(&t, pts, 4, n, &err), &err);
     float *all = malloc(sizeof(float) * n);
     uint8_t *seen = calloc(n, 1);
-    uint32_t out[64];
-    float d2[64];
-    int knn_bad = 0, ball_bad = 0, order_bad = 0;
+    uint32_t out[64], gout[256];
+    float d2[64], gd2[256], guess = 0.0f;
+    int knn_bad = 0, ball_bad = 0, order_bad = 0, guess_bad = 0;
     for (int qi = 0; qi < 300; qi++) {
         cdl_vec3 q = cdl_v3(cdl_rng_float(&r) * 1.2f - 0.1f, cdl_rng_float(&r), cdl_rng_float(&r));
         uint32_t k = 1 + (uint32_t)(cdl_rng_float(&r) * 63.0f);
@@ -81,6 +81,25 @@ static void run(const char *name, int kind, uint32_t n)
             if (j && d2[j] < d2[j - 1])
                 order_bad++;
         }
+        /* the guessed ball and selection: the same distances (as a set;
+         * the largest first) whatever the guess: carried over from the last
+         * query, none, far too small, or so large the buffer overflows */
+        float g = qi % 5 == 0 ? 1e-8f : qi % 7 == 0 ? 10.0f : qi % 11 == 0 ? 0.0f : guess;
+        guess = g;
+        uint32_t cap = k + 1 + (uint32_t)(qi % 3) * k;
+        uint32_t gn = cdl_kd_knn_guess(&t, q, k, max_d2, &guess, cap, gout, gd2);
+        if (gn != want)
+            guess_bad++;
+        for (uint32_t j = 1; j < gn; j++)
+            if (gd2[j] > gd2[0])
+                guess_bad++;
+        for (uint32_t j = 0; j < gn; j++)
+            if (all[gout[j]] != gd2[j])
+                guess_bad++;
+        qsort(gd2, gn, sizeof(float), cmp_float);
+        for (uint32_t j = 0; j < gn && j < want; j++)
+            if (gd2[j] != sorted[j])
+                guess_bad++;
         free(sorted);
         /* ball query: exactly the points within r */
         float r2 = 0.002f + 0.02f * cdl_rng_float(&r);
@@ -99,6 +118,8 @@ static void run(const char *name, int kind, uint32_t n)
     }
     CHECK(knn_bad == 0 && order_bad == 0, "%s (%u points): k-NN matches brute force in 300 queries (%d mismatches, %d out of order)",
           name, n, knn_bad, order_bad);
+    CHECK(guess_bad == 0, "%s: k-NN by a guessed ball and selection matches brute force (%d mismatches)", name,
+          guess_bad);
     CHECK(ball_bad == 0, "%s: ball queries find exactly the points within r, each once (%d mismatches)", name, ball_bad);
     free(all);
     free(seen);

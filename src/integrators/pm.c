@@ -78,7 +78,7 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
         /* for gather rays from the first vertex: the camera ray and the
          * gather ray leave maxdepth - 1 bounces to the photons */
         cdl_pm_query q = {st->opt.pm.k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, NULL, NULL,
-                          st->vis_gather, (uint32_t)st->opt.maxdepth - 1};
+                          st->vis_gather, (uint32_t)st->opt.maxdepth - 1, NULL, 0};
         rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, &q, err);
         if (rc)
             return rc;
@@ -279,13 +279,18 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
     pm_state *st = self;
     const cdl_camera *cam = &st->opt.camera;
     scratch w;
-    uint32_t k = st->opt.pm.k;
-    w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * k),
-                          malloc(sizeof(float) * k), st->vis_gather, 0};
+    uint32_t k = st->opt.pm.k, cap = 4 * k;
+    w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * cap),
+                          malloc(sizeof(float) * cap), st->vis_gather, 0, NULL, cap};
     w.qc = w.qg;
     w.qgx = w.qg;
     w.qgx.vis = st->vis_camera;
     w.qcx = w.qgx;
+    /* the camera's points are coherent pixel after pixel: each query's
+     * radius is the next one's first guess (per map) */
+    float guess_g = 0.0f, guess_c = 0.0f;
+    w.qgx.guess = &guess_g;
+    w.qcx.guess = &guess_c;
     uint64_t bad = 0, lsum = 0, lpts = 0;
     if (w.qg.idx && w.qg.d2 && !cdl_lcon_scratch_init(&w.lc, st->scene->nlights)) {
         for (int y = y0; y < y1; y++)

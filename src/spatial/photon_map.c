@@ -102,7 +102,9 @@ static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 
 {
     if (!m->n || !m->built || !q->k)
         return 0;
-    uint32_t n = cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
+    uint32_t n = q->guess && q->cap > q->k
+                     ? cdl_kd_knn_guess(&m->kd, x, q->k, q->max_r2, q->guess, q->cap, q->idx, q->d2)
+                     : cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
     *r2 = n == q->k ? q->d2[0] : q->max_r2;
     return *r2 > 0.0f ? n : 0;
 }
@@ -221,7 +223,7 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
     {
         uint32_t *idx = malloc(sizeof(uint32_t) * k);
         float *d2 = malloc(sizeof(float) * k);
-        cdl_pm_query q = {k, qt->max_r2, qt->kernel, 0, idx, d2, qt->vis, qt->max_depth};
+        cdl_pm_query q = {k, qt->max_r2, qt->kernel, 0, idx, d2, qt->vis, qt->max_depth, NULL, 0};
         if (!idx || !d2) {
 #pragma omp atomic write
             fail = 1;

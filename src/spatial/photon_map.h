@@ -88,6 +88,9 @@ typedef struct cdl_pm_query {
     float *d2;
     cdl_vis vis;
     uint32_t max_depth; /* photons of deeper bounces left out as skipped ones; 0: none */
+    float *guess;       /* coherent queries (pixel after pixel): the radius^2 to try first
+                         * (cdl_kd_knn_guess), updated by each query; NULL: a k-NN heap */
+    uint32_t cap;       /* entries idx and d2 hold (>= k) */
 } cdl_pm_query;
 
 /* Reflected radiance at x towards wo: sum of f(wo, wi_p) flux_p w(d_p)

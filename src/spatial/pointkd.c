@@ -261,6 +261,128 @@ static uint32_t ball_search(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_v
     return count;
 }
 
+/* Every point within r2 into (idx, d2) while at most cap fit; 0, or -1
+ * when they did not. */
+typedef struct collect {
+    uint32_t n, cap;
+    uint32_t *idx;
+    float *d2;
+} collect;
+
+static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2, collect *c)
+{
+    while (lo < hi) {
+        if (hi - lo <= 16) {
+            for (uint32_t i = lo; i < hi; i++) {
+                uint32_t p = t->identity ? i : t->idx[i];
+                float d = dist2(t, p, q);
+                if (d <= r2) {
+                    if (c->n == c->cap)
+                        return -1;
+                    c->idx[c->n] = p;
+                    c->d2[c->n++] = d;
+                }
+            }
+            return 0;
+        }
+        uint32_t mid = lo + (hi - lo) / 2, p = t->identity ? mid : t->idx[mid];
+        float d = dist2(t, p, q);
+        if (d <= r2) {
+            if (c->n == c->cap)
+                return -1;
+            c->idx[c->n] = p;
+            c->d2[c->n++] = d;
+        }
+        int a = t->axis[mid];
+        float delta = (a == 0 ? q.x : a == 1 ? q.y : q.z) - coord(t, p, a);
+        int go_left = delta <= 0.0f || delta * delta <= r2;
+        int go_right = delta >= 0.0f || delta * delta <= r2;
+        if (go_left && go_right) {
+            if (collect_ball(t, lo, mid, q, r2, c))
+                return -1;
+            lo = mid + 1;
+        } else if (go_left) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    return 0;
+}
+
+static void swap_at(uint32_t *idx, float *d2, uint32_t a, uint32_t b)
+{
+    float fd = d2[a];
+    uint32_t fi = idx[a];
+    d2[a] = d2[b];
+    idx[a] = idx[b];
+    d2[b] = fd;
+    idx[b] = fi;
+}
+
+/* Reorders so that [0, k) holds k smallest distances (quickselect with
+ * a three-way partition: equal distances cannot stall it). */
+static void select_k(uint32_t *idx, float *d2, uint32_t n, uint32_t k)
+{
+    uint32_t lo = 0, hi = n; /* position k - 1 lies in [lo, hi) */
+    while (hi - lo > 1) {
+        float a = d2[lo], b = d2[lo + (hi - lo) / 2], c = d2[hi - 1];
+        float pv = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        uint32_t lt = lo, i = lo, gt = hi; /* [lo, lt) < pv, [lt, i) == pv, [gt, hi) > pv */
+        while (i < gt) {
+            if (d2[i] < pv)
+                swap_at(idx, d2, lt++, i++);
+            else if (d2[i] > pv)
+                swap_at(idx, d2, i, --gt);
+            else
+                i++;
+        }
+        if (k - 1 < lt)
+            hi = lt;
+        else if (k - 1 >= gt)
+            lo = gt;
+        else
+            return;
+    }
+}
+
+uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, float *guess, uint32_t cap,
+                          uint32_t *out, float *d2)
+{
+    if (k == 0 || t->n == 0)
+        return 0;
+    float r2 = guess && *guess > 0.0f ? *guess : 0.0f;
+    for (int tries = 0; cap > k && r2 > 0.0f && tries < 3; tries++) {
+        if (r2 > max_d2)
+            r2 = max_d2;
+        collect c = {0, cap, out, d2};
+        if (collect_ball(t, 0, t->n, q, r2, &c)) {
+            r2 *= 0.5f; /* the points near q are denser than the guess's */
+            continue;
+        }
+        if (c.n < k && r2 < max_d2) {
+            /* on a surface the count grows with r^2 */
+            r2 *= c.n ? 1.3f * (float)k / (float)c.n : 4.0f;
+            continue;
+        }
+        uint32_t n = c.n < k ? c.n : k;
+        if (c.n > k)
+            select_k(out, d2, c.n, k);
+        uint32_t far = 0;
+        for (uint32_t i = 1; i < n; i++)
+            far = d2[i] > d2[far] ? i : far;
+        if (n)
+            swap_at(out, d2, 0, far);
+        if (n == k)
+            *guess = d2[0] * 1.2f; /* the next query's, a little wider */
+        return n;
+    }
+    uint32_t n = cdl_kd_knn_heap(t, q, k, max_d2, out, d2);
+    if (guess && n == k)
+        *guess = d2[0] * 1.2f;
+    return n;
+}
+
 uint32_t cdl_kd_ball(const cdl_kdtree *t, cdl_vec3 q, float r2, cdl_kd_visit fn, void *ctx)
 {
     return t->n ? ball_search(t, 0, t->n, q, r2, fn, ctx) : 0;

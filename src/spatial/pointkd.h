@@ -36,6 +36,16 @@ uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, u
 uint32_t cdl_kd_knn_heap(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out,
                          float *d2);
 
+/* The same as cdl_kd_knn_heap (the same points, ties aside) for a caller
+ * whose queries are coherent (neighbouring pixels): a ball query of the
+ * radius^2 *guess, then a selection of the k nearest, which is cheaper
+ * than keeping a heap when k is large; the heap when the ball holds too
+ * few or more than cap points after a few tries. out and d2 hold cap >= k
+ * entries. *guess becomes the next query's (the k-th distance, widened a
+ * little); 0 to start. */
+uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, float *guess, uint32_t cap,
+                          uint32_t *out, float *d2);
+
 /* For a caller that has moved point idx[i] to position i (tree order):
  * the indirection becomes the identity, and traversal cache-friendly. */
 void cdl_kd_make_identity(cdl_kdtree *t);
