@@ -78,9 +78,9 @@ static void traversal(void)
     for (uint32_t k = 0; k < t.nparts; k++)
         parts_cover += t.parts[k].hi - t.parts[k].lo;
     CHECK(parts_cover == n && t.nparts > 8, "%u parts cover the samples once", t.nparts);
-    cdl_splat_hits a = {0}, b = {0}, c = {0};
+    cdl_splat_hits a = {0}, b = {0}, c = {0}, e = {0};
     uint32_t wrong = 0, total = 0, wdiff = 0;
-    uint64_t tested_cull = 0, tested_plain = 0;
+    uint64_t tested_cull = 0, tested_plain = 0, tested_slabs = 0;
     for (int k = 0; k < 600; k++) {
         cdl_splat_ray ray;
         ray.o = cdl_v3(1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f);
@@ -90,17 +90,20 @@ static void traversal(void)
         ray.h0 = 0.1f * cdl_rng_float(&r);
         ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
         ray.cap = k % 3 == 1 ? 0.0f : 4.0f;
-        a.n = b.n = c.n = 0;
+        a.n = b.n = c.n = e.n = 0;
         cdl_skd_splat_brute(&t, UINT32_MAX, &ray, &a);
         uint64_t t0 = b.tested;
-        cdl_skd_splat(&t, UINT32_MAX, &ray, 1, &b);
+        cdl_skd_splat(&t, UINT32_MAX, &ray, CDL_SKD_CULL, &b);
         tested_cull += b.tested - t0;
         t0 = c.tested;
         for (uint32_t q = 0; q < t.nparts; q++)
-            cdl_skd_splat(&t, q, &ray, k % 4 == 0, &c);
+            cdl_skd_splat(&t, q, &ray, k % 4 == 0 ? CDL_SKD_CULL : 0, &c);
         tested_plain += c.tested - t0;
-        cdl_splat_hits *all[3] = {&a, &b, &c};
-        for (int o = 0; o < 3; o++)
+        t0 = e.tested;
+        cdl_skd_splat(&t, UINT32_MAX, &ray, CDL_SKD_CULL | CDL_SKD_SLABS, &e);
+        tested_slabs += e.tested - t0;
+        cdl_splat_hits *all[4] = {&a, &b, &c, &e};
+        for (int o = 0; o < 4; o++)
             if (all[o]->n)
                 qsort(all[o]->h, all[o]->n, sizeof *all[o]->h, cmp_hit);
         total += a.n;
@@ -110,8 +113,8 @@ static void traversal(void)
         float wmax = 0.0f;
         for (uint32_t i = 0; i < a.n; i++)
             wmax = fmaxf(wmax, a.h[i].w);
-        const cdl_splat_hits *other[2] = {&b, &c};
-        for (int o = 0; o < 2; o++) {
+        const cdl_splat_hits *other[3] = {&b, &c, &e};
+        for (int o = 0; o < 3; o++) {
             const cdl_splat_hits *x = other[o];
             uint32_t i = 0, j = 0;
             while (i < a.n || j < x->n) {
@@ -129,15 +132,18 @@ static void traversal(void)
         }
     }
     CHECK(wrong == 0 && wdiff == 0 && total > 20000,
-          "frustum traversal = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
+          "frustum traversal (bounding spheres, whole tree and part by part; Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
           "differ by more than 1e-4 of the ray's largest)",
           total, wrong, wdiff);
     CHECK(tested_cull < 20ull * total, "the traversal tests few samples per feasible one (%.2f)",
           (double)tested_cull / total);
+    CHECK(tested_cull < tested_slabs, "bounding spheres test fewer samples than Algorithm 1's slabs (%.2f, %.2f per "
+          "feasible one)", (double)tested_cull / total, (double)tested_slabs / total);
     (void)tested_plain;
     free(a.h);
     free(b.h);
     free(c.h);
+    free(e.h);
     cdl_skd_free(&t);
     free(p);
     free(nr);

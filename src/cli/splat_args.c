@@ -5,7 +5,8 @@
 
 #include "cli/args.h"
 
-static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap"};
+static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
+                               "--traversal"};
 
 int cdl_splat_arg_kind(const char *o)
 {
@@ -56,6 +57,13 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
             sp->cap = 4.0f;
         else
             rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected plane or hemisphere, got '%s'", v);
+    } else if (!strcmp(o, "--traversal")) {
+        if (!strcmp(v, "sphere"))
+            sp->slabs = 0;
+        else if (!strcmp(v, "slabs"))
+            sp->slabs = 1;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected sphere or slabs, got '%s'", v);
     } else if (!strcmp(o, "--cull-nodes")) {
         if (!strcmp(v, "on"))
             sp->cull = 1;
@@ -86,6 +94,10 @@ void cdl_splat_args_help(void)
            "                          light alone)\n"
            "      --eye-samples N     eye samples per pixel and pass (default 1)\n"
            "      --cull-nodes on|off back-face-culling nodes in the eye-sample tree (default on)\n"
+           "      --traversal KIND    how a photon ray finds its eye samples: sphere (each\n"
+           "                          node's bounding sphere against the frustum; default) or\n"
+           "                          slabs (the report's Algorithm 1: the same samples, about\n"
+           "                          twice as many tested)\n"
            "      --cap KIND          eye samples beyond a photon ray's hit: plane (fed if the\n"
            "                          ray reached their tangent plane, out to 4 h: consistent;\n"
            "                          default) or hemisphere (the report's Algorithm 2: biased\n"

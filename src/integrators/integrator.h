@@ -64,6 +64,7 @@ typedef struct cdl_splat_options {
     int direct_sample;   /* direct light by light sampling instead of direct photons */
     uint32_t eye_samples; /* eye samples per pixel and pass */
     int cull;            /* back-face-culling nodes in the eye-sample tree */
+    int slabs;           /* the report's 1D slab traversal (Algorithm 1) instead of bounding spheres */
     float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;

@@ -262,6 +262,7 @@ void splat_maps_splat(splat_state *s)
     if (s->want_bw)
         memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
     uint64_t splats = 0, tested = 0, nodes = 0;
+    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
     for (uint32_t part = 0; part < s->tree.nparts; part++) {
         cdl_skd_count cnt = {0, 0};
@@ -273,7 +274,7 @@ void splat_maps_splat(splat_state *s)
             cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
             c.r = r;
             c.ready = 0;
-            cdl_skd_splat_visit(&s->tree, part, &sr, s->opt.splat.cull, splat_batch, &c, &cnt);
+            cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
         }
         splats += c.splats;
         tested += cnt.tested;

@@ -136,6 +136,11 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
     return (float)(2.0 / CDL_PI) / h2 * (1.0f - (r2 > 0.0f ? r2 : 0.0f) / h2) * -c;
 }
 
+/* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
+ * report's traversal) instead of the default bounding-sphere test per
+ * node (the same samples, fewer tested). */
+enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2 };
+
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
  * (m <= 16) of which those in `mask` (bit i: sample first + i; never
@@ -145,10 +150,10 @@ typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, uint32_t ma
 typedef struct cdl_skd_count {
     uint64_t tested, nodes;
 } cdl_skd_count;
-int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_skd_visit fn,
+int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
                         void *ctx, cdl_skd_count *cnt);
 /* The same appended to out. Returns 0, or -1 out of memory. */
-int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int cull, cdl_splat_hits *out);
+int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_splat_hits *out);
 /* The same by testing every sample of the part one by one with
  * cdl_splat_weight (for tests: the traversal's leaves test 16 at a time). */
 int cdl_skd_splat_brute(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, cdl_splat_hits *out);
