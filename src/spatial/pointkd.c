@@ -374,12 +374,12 @@ uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max
         if (n)
             swap_at(out, d2, 0, far);
         if (n == k)
-            *guess = d2[0] * 1.2f; /* the next query's, a little wider */
+            *guess = d2[0] * 1.05f; /* the next query's, a little wider */
         return n;
     }
     uint32_t n = cdl_kd_knn_heap(t, q, k, max_d2, out, d2);
     if (guess && n == k)
-        *guess = d2[0] * 1.2f;
+        *guess = d2[0] * 1.05f;
     return n;
 }
 
