@@ -6,7 +6,7 @@
 #include "cli/args.h"
 
 static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
-                               "--traversal"};
+                               "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max"};
 
 int cdl_splat_arg_kind(const char *o)
 {
@@ -57,6 +57,18 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
             sp->cap = 4.0f;
         else
             rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected plane or hemisphere, got '%s'", v);
+    } else if (!strcmp(o, "--filter")) {
+        rc = cdl_arg_float(o, v, 0.0, 1e12, &d, err);
+        sp->filter = (float)d;
+    } else if (!strcmp(o, "--filter-normal")) {
+        rc = cdl_arg_float(o, v, 0.0, 180.0, &d, err);
+        sp->filter_normal = (float)d;
+    } else if (!strcmp(o, "--filter-depth")) {
+        rc = cdl_arg_float(o, v, 0.0, 1e3, &d, err);
+        sp->filter_depth = (float)d;
+    } else if (!strcmp(o, "--filter-max")) {
+        rc = cdl_arg_int(o, v, 0, 255, &l, err);
+        sp->filter_max = (int)l;
     } else if (!strcmp(o, "--traversal")) {
         if (!strcmp(v, "sphere"))
             sp->slabs = 0;
@@ -94,6 +106,13 @@ void cdl_splat_args_help(void)
            "                          light alone)\n"
            "      --eye-samples N     eye samples per pixel and pass (default 1)\n"
            "      --cull-nodes on|off back-face-culling nodes in the eye-sample tree (default on)\n"
+           "      --filter N          image-space filtering of the radiance maps (§6.2): each\n"
+           "                          pixel averaged over a box of its own surface segment,\n"
+           "                          the smallest holding N photon splats (0: off; default)\n"
+           "      --filter-normal DEG segments: neighbours' normals within DEG (default 20)\n"
+           "      --filter-depth T    segments: second difference of 1/depth within T of it\n"
+           "                          (default 0.05)\n"
+           "      --filter-max R      largest box: (2R+1)^2 pixels (default 25)\n"
            "      --traversal KIND    how a photon ray finds its eye samples: sphere (each\n"
            "                          node's bounding sphere against the frustum; default) or\n"
            "                          slabs (the report's Algorithm 1: the same samples, about\n"

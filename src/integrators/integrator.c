@@ -48,6 +48,9 @@ void cdl_options_default(cdl_options *o)
     o->splat.mode = CDL_SPLAT_DIRECT;
     o->splat.eye_samples = 1;
     o->splat.cull = 1;
+    o->splat.filter_normal = 20.0f;
+    o->splat.filter_depth = 0.05f;
+    o->splat.filter_max = 25;
     o->splat.cap = 4.0f;
 }
 

@@ -65,6 +65,10 @@ typedef struct cdl_splat_options {
     uint32_t eye_samples; /* eye samples per pixel and pass */
     int cull;            /* back-face-culling nodes in the eye-sample tree */
     int slabs;           /* the report's 1D slab traversal (Algorithm 1) instead of bounding spheres */
+    float filter;        /* image-space filter (§6.2): photon splats a pixel's box gathers; 0: none */
+    float filter_normal; /* segments: normals within this many degrees */
+    float filter_depth;  /* segments: second difference of 1/depth within this share of it */
+    int filter_max;      /* largest box half-width in pixels */
     float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;

@@ -80,13 +80,15 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;
     s->nslots = (uint32_t)(npix * o->eye_samples);
     s->base = calloc(npix, sizeof *s->base);
+    s->dz = calloc(npix, sizeof *s->dz);
+    s->dn = calloc(npix, sizeof *s->dn);
     s->pix = calloc(npix, sizeof *s->pix);
     s->slot = malloc(sizeof *s->slot * s->nslots);
     s->sp = malloc(sizeof *s->sp * s->nslots);
     s->sn = malloc(sizeof *s->sn * s->nslots);
     s->sflags = malloc(s->nslots);
     s->svalid = malloc(s->nslots);
-    if (!s->base || !s->pix || !s->slot || !s->sp || !s->sn || !s->sflags || !s->svalid)
+    if (!s->base || !s->dz || !s->dn || !s->pix || !s->slot || !s->sp || !s->sn || !s->sflags || !s->svalid)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for %u eye samples", s->nslots);
     return splat_maps_init(s, err);
 }
@@ -101,6 +103,7 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
     for (int x = 0; x < cam->width; x++) {
         uint32_t p = (uint32_t)y * (uint32_t)cam->width + (uint32_t)x;
         cdl_vec3 base = cdl_v3(0.0f, 0.0f, 0.0f);
+        s->dz[p] = 0.0f;
         for (uint32_t j = 0; j < E; j++) {
             uint32_t k = p * E + j;
             s->svalid[k] = 0;
@@ -109,8 +112,8 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
             cdl_sampler_start(&smp, s->opt.sampler, s->opt.seed, k, pass);
             cdl_sampler_2d(&smp, &jx, &jy);
             cdl_visible v;
-            int hit = cdl_find_visible(sc, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
-                                       s->opt.maxdepth, &smp, rays, &v);
+            cdl_vec3 dir = cdl_camera_ray(cam, (float)x + jx, (float)y + jy);
+            int hit = cdl_find_visible(sc, cam->eye, dir, s->opt.maxdepth, &smp, rays, &v);
             base = cdl_add(base, v.L);
             if (!hit)
                 continue;
@@ -141,6 +144,10 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
             s->sn[k] = ng;
             s->sflags[k] = v.b.type == CDL_MAT_ROUGH_DIELECTRIC ? CDL_SKD_TWO_SIDED : 0;
             s->svalid[k] = 1;
+            if (s->dz[p] == 0.0f) { /* the discontinuity buffer: the pixel's first sample */
+                s->dz[p] = v.dist * cdl_dot(dir, cam->fwd);
+                s->dn[p] = f.n;
+            }
         }
         s->base[p] = cdl_scale(base, 1.0f / (float)E);
     }
@@ -291,6 +298,11 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     const cdl_camera *cam = &s->opt.camera;
     size_t npix = (size_t)cam->width * (size_t)cam->height;
     memset(s->pix, 0, sizeof *s->pix * npix);
+    double tf = cdl_time_now();
+    rc = splat_filter(s, err);
+    if (rc)
+        return rc;
+    s->st.t_filter += cdl_time_now() - tf;
     splat_maps_resolve(s);
     uint64_t bad = 0;
     for (size_t p = 0; p < npix; p++)
@@ -349,6 +361,9 @@ static void splat_report(const void *self)
            "(eye-sample tree: %u nodes, %u leaves, %u culling, %u empty, depth %u)\n",
            (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_brdf,
            s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
+    if (s->opt.splat.filter > 0.0f)
+        printf("splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
+               (double)t->segments / P);
 }
 
 static void splat_destroy(void *self)
@@ -363,11 +378,14 @@ static void splat_destroy(void *self)
     free(s->slot);
     free(s->eye);
     free(s->base);
+    free(s->dz);
+    free(s->dn);
     free(s->pix);
     for (int c = 0; c < 3; c++)
         free(s->E[c]);
     free(s->wsum);
     free(s->izsum);
+    free(s->nsum);
     free(s->gloss);
     free(s->gmap);
     free(s->bw);

@@ -26,8 +26,8 @@ typedef struct splat_eye {
 } splat_eye;
 
 typedef struct splat_stats {
-    double t_ray, t_light, t_build, t_solve, t_brdf, t_total;
-    uint64_t rays_stored, splats, tested, nodes, samples, passes;
+    double t_ray, t_light, t_build, t_solve, t_brdf, t_filter, t_total;
+    uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
     size_t peak_bytes;
 } splat_stats;
 
@@ -44,6 +44,8 @@ typedef struct splat_state {
     splat_eye *slot, *eye;
     uint32_t nslots, neye;
     cdl_vec3 *base;   /* per pixel: emission seen and direct light sampled, this pass */
+    float *dz;        /* discontinuity buffer, per pixel: view depth of its first eye sample (0: none) */
+    cdl_vec3 *dn;     /* and the normal of the side seen */
     cdl_vec3 *pix;    /* per pixel: this pass's image */
     cdl_skd tree;
     cdl_skd_params kp;
@@ -53,7 +55,7 @@ typedef struct splat_state {
      * Lambertian sample needs nothing else in any mode (its BSDF is one
      * constant: kd / pi E; its SH table holds only the DC term); the others
      * (gloss[q] != SPLAT_LAMBERT) get K x 3 floats in gmap. */
-    float *E[3], *wsum, *izsum;
+    float *E[3], *wsum, *izsum, *nsum; /* nsum: splats received */
     uint32_t *gloss;  /* index into gmap, or SPLAT_LAMBERT */
     float *gmap;      /* histogram: [stratum][glossy sample][3]; SH: [glossy sample][k][3]; direct: [g][3] */
     uint32_t nglossy, gcap;
@@ -75,5 +77,13 @@ size_t splat_maps_bytes(const splat_state *s);
 void splat_maps_splat(splat_state *s);
 /* Each eye sample's reflected radiance, weighted, into s->pix. */
 void splat_maps_resolve(splat_state *s);
+/* Filters the maps in image space within surface segments (§6.2, splat_filter.c). */
+int splat_filter(splat_state *s, cdl_error *err);
+/* RGB of entry k (stratum or coefficient) of glossy sample g. */
+static inline float *splat_gmap_at(const splat_state *s, uint32_t g, int k)
+{
+    size_t i = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? (size_t)k * s->nglossy + g : (size_t)g * s->K + (size_t)k;
+    return &s->gmap[3 * i];
+}
 
 #endif

@@ -44,15 +44,10 @@ static void icosahedron(cdl_vec3 *c)
             }
 }
 
-/* RGB of entry k (stratum or coefficient) of glossy sample g: the
- * histogram is stored as one image per stratum (a ray's splats all go to
- * its stratum: neighbouring samples, neighbouring entries), SH per sample
- * (a splat writes all 16). */
-static inline float *gmap_at(const splat_state *s, uint32_t g, int k)
-{
-    size_t i = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? (size_t)k * s->nglossy + g : (size_t)g * s->K + (size_t)k;
-    return &s->gmap[3 * i];
-}
+/* The glossy maps (splat_gmap_at): the histogram is stored as one image
+ * per stratum (a ray's splats all go to its stratum: neighbouring samples,
+ * neighbouring entries), SH per sample (a splat writes all 16). */
+#define gmap_at splat_gmap_at
 
 static int stratum(const splat_state *s, cdl_vec3 w)
 {
@@ -95,8 +90,9 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
             s->E[c] = malloc(sizeof(float) * n);
         s->wsum = malloc(sizeof(float) * n);
         s->izsum = malloc(sizeof(float) * n);
+        s->nsum = malloc(sizeof(float) * n);
         s->gloss = malloc(sizeof(uint32_t) * n);
-        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->gloss)
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->nsum || !s->gloss)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
     uint32_t ng = 0;
@@ -123,7 +119,7 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
 size_t splat_maps_bytes(const splat_state *s)
 {
     size_t n = s->wsum ? (size_t)s->nslots + 16 : 0;
-    return n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+    return n * (6 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
@@ -218,7 +214,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     ray_ctx *c = ctx;
     splat_state *s = c->s;
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
-    float *ws = s->wsum + first, *zs = s->izsum + first;
+    float *ws = s->wsum + first, *zs = s->izsum + first, *ns = s->nsum + first;
     const uint32_t *gl = s->gloss + first;
 #if defined(__AVX512F__)
     const __mmask16 k = (__mmask16)mask;
@@ -228,6 +224,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.z), _mm512_maskz_loadu_ps(k, eb)));
     _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
     _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
+    _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
     c->splats += (uint64_t)__builtin_popcount(mask);
 #else
@@ -241,6 +238,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
         eb[i] += w[i] * fb;
         ws[i] += w[i];
         zs[i] += iz[i];
+        ns[i] += 1.0f;
         glossy |= gl[i] != SPLAT_LAMBERT;
         c->splats++;
     }
@@ -258,6 +256,7 @@ void splat_maps_splat(splat_state *s)
         memset(s->E[c], 0, sizeof(float) * n);
     memset(s->wsum, 0, sizeof(float) * n);
     memset(s->izsum, 0, sizeof(float) * n);
+    memset(s->nsum, 0, sizeof(float) * n);
     memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
     if (s->want_bw)
         memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);

@@ -9,6 +9,7 @@ int cdl_find_visible(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, int maxdepth, c
 {
     v->L = cdl_v3(0.0f, 0.0f, 0.0f);
     v->beta = cdl_v3(1.0f, 1.0f, 1.0f);
+    v->dist = 0.0f;
     for (int depth = 0;; depth++) {
         cdl_hit h;
         (*rays)++;
@@ -17,6 +18,7 @@ int cdl_find_visible(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, int maxdepth, c
                 v->L = cdl_add(v->L, cdl_mul(v->beta, s->lights[s->env_light].L));
             return 0;
         }
+        v->dist += h.t;
         cdl_surface_at(s, &h, &v->sf);
         cdl_scene_bsdf(s, &v->sf, &v->b);
         v->wo = cdl_neg(d);

@@ -17,6 +17,7 @@ typedef struct cdl_visible {
     cdl_bsdf b;
     cdl_vec3 wo;   /* unit direction back along the ray */
     int depth;     /* specular bounces before the point */
+    float dist;    /* length of the chain from the ray's origin to the point */
 } cdl_visible;
 
 /* 1 if the ray from o along d reaches a non-specular point with fewer
