@@ -34,7 +34,7 @@ import re, sys
 t = open(sys.argv[1]).read()
 secs = re.search(r"spp in ([0-9.]+) s", t).group(1)
 mib = re.search(r"(?:memory|maps) ([0-9.]+) MiB", t)
-split = re.search(r"T_ray ([0-9.]+), T_light ([0-9.]+), T_build ([0-9.]+), T_solve ([0-9.]+), T_brdf ([0-9.]+)", t)
+split = re.search(r"T_ray ([0-9.]+), T_light ([0-9.]+), T_build ([0-9.]+), T_solve ([0-9.]+), (?:T_cache [0-9.]+, )?T_brdf ([0-9.]+)", t)
 parts = list(split.groups()) if split else [""] * 5
 print(",".join([sys.argv[2], secs, mib.group(1) if mib else ""] + parts))
 EOF

@@ -29,7 +29,7 @@ import re, sys
 t = open(sys.argv[1]).read()
 secs = re.search(r"spp in ([0-9.]+) s", t).group(1)
 mib = re.search(r"(?:memory|maps) ([0-9.]+) MiB", t)
-sp = re.search(r"T_ray ([0-9.]+), T_light ([0-9.]+), T_build ([0-9.]+), T_solve ([0-9.]+), T_brdf ([0-9.]+)", t)
+sp = re.search(r"T_ray ([0-9.]+), T_light ([0-9.]+), T_build ([0-9.]+), T_solve ([0-9.]+), (?:T_cache [0-9.]+, )?T_brdf ([0-9.]+)", t)
 ph = re.search(r"photon tracing ([0-9.]+) s", t)
 cells = list(sp.groups()) if sp else ["", ph.group(1) if ph else "", "", "", ""]
 print("| " + " | ".join([sys.argv[2], sys.argv[3]] + cells + [secs, mib.group(1) if mib else ""]) + " |")

@@ -65,7 +65,10 @@ static void render_help(void)
            "                          length, Fig. 4) or strata (the contribution of each\n"
            "                          eye path length as layers strata1..strata8, Fig. 5);\n"
            "                          splat: bandwidth (the kernel-weighted mean bandwidth of\n"
-           "                          the photon rays of depth 2, 3 and any, as R, G, B)\n"
+           "                          the photon rays of depth 2, 3 and any, as R, G, B) or,\n"
+           "                          with --cache, records (R: 1 at the records, G: records\n"
+           "                          a pixel gathered from, B: the irradiance gradient's\n"
+           "                          magnitude)\n"
            "      --shadow-rays KIND  rigi/ir/gkde: bundle (one Embree ray stream per point\n"
            "                          light and tile, or per footprint; default) or single;\n"
            "                          pm: a number (below)\n"
@@ -268,9 +271,11 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
                 a->aov_strata = 1;
             else if (!strcmp(v, "bandwidth"))
                 a->aov_bandwidth = 1;
+            else if (!strcmp(v, "records"))
+                a->aov_records = 1;
             else
-                return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected pathlength, strata or bandwidth, got '%s'",
-                                     v);
+                return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                                     "expected pathlength, strata, bandwidth or records, got '%s'", v);
         } else if (!strcmp(o, "--shadow-rays")) {
             if (!strcmp(v, "bundle"))
                 a->single_shadow_rays = 0;
@@ -296,7 +301,7 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "%ld paths cannot fill %ld x %ld interleaved sets", a->light_paths,
                              a->interleave, a->interleave);
-    if (a->aov_pathlength || a->aov_strata || a->aov_bandwidth) {
+    if (a->aov_pathlength || a->aov_strata || a->aov_bandwidth || a->aov_records) {
         int exr = 0;
         for (int i = 0; i < a->nout; i++)
             exr |= cdl_image_has_ext(a->out[i], ".exr");
@@ -461,6 +466,8 @@ int cdl_cmd_render(int argc, char **argv)
     if (!rc)
         rc = cdl_film_init(&film, a.width, a.height, &err);
     if (!rc && a.aov_pathlength && cdl_film_add_aov(&film, "pathlength", 1, &err) < 0)
+        rc = err.code;
+    if (!rc && a.aov_records && cdl_film_add_aov(&film, "records", 3, &err) < 0)
         rc = err.code;
     if (!rc && a.aov_bandwidth && cdl_film_add_aov(&film, "bandwidth", 3, &err) < 0)
         rc = err.code;

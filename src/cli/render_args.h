@@ -29,7 +29,7 @@ typedef struct render_args {
     long light_paths, interleave;
     double threshold, clamp;
     int strata_distance, single_shadow_rays;
-    int aov_pathlength, aov_strata, aov_bandwidth;
+    int aov_pathlength, aov_strata, aov_bandwidth, aov_records;
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;

@@ -6,7 +6,8 @@
 #include "cli/args.h"
 
 static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
-                               "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max"};
+                               "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max",
+                               "--cache", "--cache-min", "--cache-weight", "--cache-spacing"};
 
 int cdl_splat_arg_kind(const char *o)
 {
@@ -69,6 +70,26 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
     } else if (!strcmp(o, "--filter-max")) {
         rc = cdl_arg_int(o, v, 0, 255, &l, err);
         sp->filter_max = (int)l;
+    } else if (!strcmp(o, "--cache")) {
+        rc = cdl_arg_float(o, v, 0.0, 100.0, &d, err);
+        sp->cache = (float)d;
+    } else if (!strcmp(o, "--cache-min")) {
+        rc = cdl_arg_int(o, v, 1, 1000, &l, err);
+        sp->cache_min = (uint32_t)l;
+    } else if (!strcmp(o, "--cache-weight")) {
+        if (!strcmp(v, "report"))
+            sp->cache_ward = 0;
+        else if (!strcmp(v, "ward"))
+            sp->cache_ward = 1;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected report or ward, got '%s'", v);
+    } else if (!strcmp(o, "--cache-spacing")) {
+        if (!strcmp(v, "gradient"))
+            sp->cache_geometric = 0;
+        else if (!strcmp(v, "geometric"))
+            sp->cache_geometric = 1;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected gradient or geometric, got '%s'", v);
     } else if (!strcmp(o, "--traversal")) {
         if (!strcmp(v, "sphere"))
             sp->slabs = 0;
@@ -113,6 +134,14 @@ void cdl_splat_args_help(void)
            "      --filter-depth T    segments: second difference of 1/depth within T of it\n"
            "                          (default 0.05)\n"
            "      --filter-max R      largest box: (2R+1)^2 pixels (default 25)\n"
+           "      --cache EPS         radiance caching (§6.3) with cache error EPS (0: off;\n"
+           "                          default): the maps computed at records only, by\n"
+           "                          splatting, and interpolated within radius EPS R (R: the\n"
+           "                          harmonic mean distance of the rays, 2 to 50 pixels)\n"
+           "      --cache-min N       records each pixel gathers from, N_c (default 5)\n"
+           "      --cache-weight KIND report (eq. 6.7; default) or ward (Ward 1988)\n"
+           "      --cache-spacing KIND gradient (R shrunk where the splats' irradiance\n"
+           "                          gradient is steep, eq. 6.12; default) or geometric\n"
            "      --traversal KIND    how a photon ray finds its eye samples: sphere (each\n"
            "                          node's bounding sphere against the frustum; default) or\n"
            "                          slabs (the report's Algorithm 1: the same samples, about\n"

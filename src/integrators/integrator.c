@@ -51,6 +51,7 @@ void cdl_options_default(cdl_options *o)
     o->splat.filter_normal = 20.0f;
     o->splat.filter_depth = 0.05f;
     o->splat.filter_max = 25;
+    o->splat.cache_min = 5;
     o->splat.cap = 4.0f;
 }
 

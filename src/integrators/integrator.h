@@ -69,6 +69,11 @@ typedef struct cdl_splat_options {
     float filter_normal; /* segments: normals within this many degrees */
     float filter_depth;  /* segments: second difference of 1/depth within this share of it */
     int filter_max;      /* largest box half-width in pixels */
+    float cache;         /* radiance caching (§6.3): the cache error epsilon; 0: none */
+    uint32_t cache_min;  /* records every pixel gathers from, N_c */
+    int cache_ward;      /* Ward's weight instead of the report's (eq. 6.7), for comparison */
+    int cache_geometric; /* record spacing from the harmonic mean distance alone (no irradiance gradient) */
+    int cache_aov;       /* --aov records: where the records are, and their count per pixel */
     float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;

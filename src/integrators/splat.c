@@ -128,6 +128,7 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
             e->wo = v.wo;
             e->pixel = p;
             e->mat = v.sf.mat;
+            e->pw = v.dist * 2.0f * cam->tan_half / (float)cam->height;
             cdl_vec3 ng = cdl_dot(v.sf.ng, v.wo) < 0.0f ? cdl_neg(v.sf.ng) : v.sf.ng;
             cdl_vec3 n = v.b.frame.n;
             if (cdl_dot(n, v.wo) < 0.0f)
@@ -290,9 +291,15 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     s->st.rays_stored += s->rays.n;
     double t3 = cdl_time_now();
     s->st.t_light += t3 - t2;
-    splat_maps_splat(s);
+    if (s->opt.splat.cache > 0.0f) {
+        rc = splat_cache_solve(s, err); /* counts its own T_solve and T_cache */
+        if (rc)
+            return rc;
+    } else {
+        splat_maps_splat(s);
+        s->st.t_solve += cdl_time_now() - t3;
+    }
     double t4 = cdl_time_now();
-    s->st.t_solve += t4 - t3;
     if (cdl_cancel)
         return 0; /* an interrupted pass adds nothing */
     const cdl_camera *cam = &s->opt.camera;
@@ -303,6 +310,15 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     if (rc)
         return rc;
     s->st.t_filter += cdl_time_now() - tf;
+    int a_rec = cdl_film_find_aov(film, "records");
+    if (a_rec >= 0) /* before the maps become radiance */
+        for (uint32_t q = 0; q < s->neye; q++) {
+            float v[3];
+            if (splat_cache_aov(s, q, v))
+                for (int c = 0; c < 3; c++)
+                    film->aovs[a_rec].sum[3 * (size_t)s->eye[q].pixel + c] +=
+                        v[c] / (float)s->opt.splat.eye_samples;
+        }
     splat_maps_resolve(s);
     uint64_t bad = 0;
     for (size_t p = 0; p < npix; p++)
@@ -357,10 +373,11 @@ static void splat_report(const void *self)
            (double)t->samples / P, t->rays_stored ? (double)t->splats / (double)t->rays_stored : 0.0,
            t->splats ? (double)t->tested / (double)t->splats : 0.0,
            t->rays_stored ? (double)t->nodes / (double)t->rays_stored : 0.0, (double)t->peak_bytes / 1048576.0);
-    printf("splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_brdf %.2f "
+    printf("splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_cache %.2f, T_brdf %.2f "
            "(eye-sample tree: %u nodes, %u leaves, %u culling, %u empty, depth %u)\n",
-           (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_brdf,
+           (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_cache, t->t_brdf,
            s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
+    splat_cache_report(s);
     if (s->opt.splat.filter > 0.0f)
         printf("splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
                (double)t->segments / P);
@@ -389,6 +406,7 @@ static void splat_destroy(void *self)
     free(s->gloss);
     free(s->gmap);
     free(s->bw);
+    splat_cache_free(s);
     free(s->tables);
 }
 

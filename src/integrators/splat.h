@@ -23,11 +23,13 @@ typedef struct splat_eye {
     cdl_vec3 wo;     /* towards the camera */
     cdl_frame f;     /* shading normal on the seen side; t towards wo (SH tables) */
     uint32_t pixel, mat;
+    float pw;        /* a pixel's width in the world at the sample (along its chain) */
 } splat_eye;
 
 typedef struct splat_stats {
-    double t_ray, t_light, t_build, t_solve, t_brdf, t_filter, t_total;
+    double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_total;
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
+    uint64_t records, cache_passes, ray_refs;
     size_t peak_bytes;
 } splat_stats;
 
@@ -61,12 +63,28 @@ typedef struct splat_state {
     uint32_t nglossy, gcap;
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
     float *bw;        /* --aov bandwidth only: SPLAT_BW floats per sample */
+    struct splat_cache *cache; /* --cache: radiance caching (splat_cache.c) */
     int want_bw;
     cdl_vec3 strata[SPLAT_STRATA];
     cdl_sh_rot rot;
     cdl_bsdf_sh *tables; /* per material (SH mode) */
     splat_stats st;
 } splat_state;
+
+/* What one ray adds per unit of kernel weight to a glossy sample's map,
+ * computed on first use: RGB per SH coefficient, or the ray's stratum. */
+typedef struct splat_terms {
+    const cdl_photon_ray *r;
+    float sh[CDL_SH_N * 3];
+    int stratum, ready;
+    cdl_vec3 wi; /* towards the light */
+} splat_terms;
+void splat_terms_of(splat_terms *t, const splat_state *s, const cdl_photon_ray *r);
+/* One splat of the ray in t onto sample q: weight w (kernel times
+ * cosine), iz one over its distance along the ray. */
+void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float iz);
+/* Zeroes the maps for a pass. */
+void splat_maps_clear(splat_state *s);
 
 /* Radiance-map setup of the mode (strata, SH tables); 0 or an error. */
 int splat_maps_init(splat_state *s, cdl_error *err);
@@ -77,6 +95,14 @@ size_t splat_maps_bytes(const splat_state *s);
 void splat_maps_splat(splat_state *s);
 /* Each eye sample's reflected radiance, weighted, into s->pix. */
 void splat_maps_resolve(splat_state *s);
+/* Radiance caching (§6.3, splat_cache.c): the maps computed at a sparse
+ * set of eye samples (cache records) by splatting, then interpolated to
+ * every sample. Replaces splat_maps_splat; times T_solve and T_cache. */
+int splat_cache_solve(splat_state *s, cdl_error *err);
+void splat_cache_free(splat_state *s);
+void splat_cache_report(const splat_state *s);
+/* --aov records for sample q: 1 at a record, records gathered, |grad E|; 0 without a cache. */
+int splat_cache_aov(const splat_state *s, uint32_t q, float out[3]);
 /* Filters the maps in image space within surface segments (§6.2, splat_filter.c). */
 int splat_filter(splat_state *s, cdl_error *err);
 /* RGB of entry k (stratum or coefficient) of glossy sample g. */

@@ -123,73 +123,84 @@ size_t splat_maps_bytes(const splat_state *s)
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
-/* What one ray adds per unit of kernel weight, computed once per ray and
- * part, on the first glossy sample it meets: RGB per SH coefficient, or
- * the ray's stratum. */
-typedef struct ray_ctx {
-    splat_state *s;
-    const cdl_photon_ray *r;
-    float sh[CDL_SH_N * 3];
-    int stratum, ready;
-    cdl_vec3 wi; /* towards the light */
-    uint64_t splats;
-} ray_ctx;
-
-static void ray_terms(ray_ctx *c)
+void splat_terms_of(splat_terms *t, const splat_state *s, const cdl_photon_ray *r)
 {
-    const cdl_photon_ray *r = c->r;
-    c->wi = cdl_neg(r->d);
-    c->ready = 1;
-    if (c->s->opt.splat.mode == CDL_SPLAT_SH) {
+    t->r = r;
+    t->wi = cdl_neg(r->d);
+    t->ready = 1;
+    if (s->opt.splat.mode == CDL_SPLAT_SH) {
         float y[CDL_SH_N];
-        cdl_sh_eval(c->wi, y);
+        cdl_sh_eval(t->wi, y);
         for (int k = 0; k < CDL_SH_N; k++) {
-            c->sh[k * 3] = y[k] * r->flux.x;
-            c->sh[k * 3 + 1] = y[k] * r->flux.y;
-            c->sh[k * 3 + 2] = y[k] * r->flux.z;
+            t->sh[k * 3] = y[k] * r->flux.x;
+            t->sh[k * 3 + 1] = y[k] * r->flux.y;
+            t->sh[k * 3 + 2] = y[k] * r->flux.z;
         }
-    } else if (c->s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) {
-        c->stratum = stratum(c->s, c->wi);
+    } else if (s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) {
+        t->stratum = stratum(s, t->wi);
     }
 }
+
+/* Glossy sample q (map entry g) takes weight w of the ray in t. */
+static void add_glossy(splat_state *s, splat_terms *t, uint32_t q, uint32_t g, float w)
+{
+    if (!t->ready)
+        splat_terms_of(t, s, t->r);
+    const int mode = s->opt.splat.mode;
+    const cdl_vec3 flux = t->r->flux;
+    if (mode == CDL_SPLAT_SH) {
+        float *mp = gmap_at(s, g, 0);
+        for (int k = 0; k < CDL_SH_N * 3; k++)
+            mp[k] += w * t->sh[k];
+    } else if (mode == CDL_SPLAT_HISTOGRAM) {
+        float *mp = gmap_at(s, g, t->stratum);
+        mp[0] += w * flux.x;
+        mp[1] += w * flux.y;
+        mp[2] += w * flux.z;
+    } else {
+        const splat_eye *ey = &s->eye[q];
+        cdl_vec3 f = cdl_bsdf_eval(&ey->b, ey->wo, t->wi, 0);
+        float *mp = gmap_at(s, g, 0);
+        mp[0] += w * f.x * flux.x;
+        mp[1] += w * f.y * flux.y;
+        mp[2] += w * f.z * flux.z;
+    }
+}
+
+void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float iz)
+{
+    const cdl_vec3 flux = t->r->flux;
+    s->E[0][q] += w * flux.x;
+    s->E[1][q] += w * flux.y;
+    s->E[2][q] += w * flux.z;
+    s->wsum[q] += w;
+    s->izsum[q] += iz;
+    s->nsum[q] += 1.0f;
+    if (s->gloss[q] != SPLAT_LAMBERT)
+        add_glossy(s, t, q, s->gloss[q], w);
+}
+
+/* The ray being splatted through one part. */
+typedef struct ray_ctx {
+    splat_state *s;
+    splat_terms t;
+    uint64_t splats;
+} ray_ctx;
 
 /* The feasible glossy samples of a batch: the ray's light in their maps. */
 static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w)
 {
-    splat_state *s = c->s;
-    if (!c->ready)
-        ray_terms(c);
-    const int mode = s->opt.splat.mode;
-    const cdl_vec3 flux = c->r->flux;
     for (uint32_t i = 0; i < m; i++) {
-        uint32_t q = first + i, g = s->gloss[q];
-        if (!(mask >> i & 1u) || g == SPLAT_LAMBERT)
-            continue;
-        float wi = w[i];
-        if (mode == CDL_SPLAT_SH) {
-            float *mp = gmap_at(s, g, 0);
-            for (int k = 0; k < CDL_SH_N * 3; k++)
-                mp[k] += wi * c->sh[k];
-        } else if (mode == CDL_SPLAT_HISTOGRAM) {
-            float *mp = gmap_at(s, g, c->stratum);
-            mp[0] += wi * flux.x;
-            mp[1] += wi * flux.y;
-            mp[2] += wi * flux.z;
-        } else {
-            const splat_eye *ey = &s->eye[q];
-            cdl_vec3 f = cdl_bsdf_eval(&ey->b, ey->wo, c->wi, 0);
-            float *mp = gmap_at(s, g, 0);
-            mp[0] += wi * f.x * flux.x;
-            mp[1] += wi * f.y * flux.y;
-            mp[2] += wi * f.z * flux.z;
-        }
+        uint32_t q = first + i, g = c->s->gloss[q];
+        if ((mask >> i & 1u) && g != SPLAT_LAMBERT)
+            add_glossy(c->s, &c->t, q, g, w[i]);
     }
 }
 
 /* --aov bandwidth: the kernel-weighted bandwidth of the rays per sample. */
 static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
 {
-    const cdl_photon_ray *r = c->r;
+    const cdl_photon_ray *r = c->t.r;
     for (uint32_t i = 0; i < m; i++) {
         if (!(mask >> i & 1u))
             continue;
@@ -219,16 +230,17 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
 #if defined(__AVX512F__)
     const __mmask16 k = (__mmask16)mask;
     const __m512 wv = _mm512_loadu_ps(w);
-    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.x), _mm512_maskz_loadu_ps(k, er)));
-    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.y), _mm512_maskz_loadu_ps(k, eg)));
-    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(c->r->flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    const cdl_vec3 flux = c->t.r->flux;
+    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
+    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
+    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
     _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
     _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
     _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
     c->splats += (uint64_t)__builtin_popcount(mask);
 #else
-    const float fr = c->r->flux.x, fg = c->r->flux.y, fb = c->r->flux.z;
+    const float fr = c->t.r->flux.x, fg = c->t.r->flux.y, fb = c->t.r->flux.z;
     uint32_t glossy = 0;
     for (uint32_t i = 0; i < m; i++) {
         if (!(mask >> i & 1u))
@@ -249,7 +261,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
         splat_bandwidth(c, first, m, mask, w, iz);
 }
 
-void splat_maps_splat(splat_state *s)
+void splat_maps_clear(splat_state *s)
 {
     size_t n = (size_t)s->neye + 16;
     for (int c = 0; c < 3; c++)
@@ -260,6 +272,11 @@ void splat_maps_splat(splat_state *s)
     memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
     if (s->want_bw)
         memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
+}
+
+void splat_maps_splat(splat_state *s)
+{
+    splat_maps_clear(s);
     uint64_t splats = 0, tested = 0, nodes = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
@@ -271,8 +288,8 @@ void splat_maps_splat(splat_state *s)
         for (uint32_t k = 0; k < s->rays.n && !cdl_cancel; k++) {
             const cdl_photon_ray *r = &s->rays.r[k];
             cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
-            c.r = r;
-            c.ready = 0;
+            c.t.r = r;
+            c.t.ready = 0;
             cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
         }
         splats += c.splats;

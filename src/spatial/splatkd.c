@@ -226,6 +226,7 @@ static uint32_t spheres(cdl_skd *t, uint32_t node, float *lo, float *hi)
 {
     cdl_skd_node nd = t->nodes[node];
     float *sp = t->lsph + 4 * (size_t)node;
+    cdl_skd_range *rg = &t->range[node];
     uint32_t next;
     for (int a = 0; a < 3; a++) {
         lo[a] = INFINITY;
@@ -233,6 +234,8 @@ static uint32_t spheres(cdl_skd *t, uint32_t node, float *lo, float *hi)
     }
     if ((nd.b & 3) == 3 && ((nd.b >> 2) & 3) == KIND_LEAF) {
         uint32_t l = nd.b >> 4, h = l + nd.a;
+        rg->lo = l;
+        rg->hi = h;
         for (int a = 0; a < 3; a++)
             for (uint32_t i = l; i < h; i++) {
                 lo[a] = t->p[a][i] < lo[a] ? t->p[a][i] : lo[a];
@@ -240,13 +243,19 @@ static uint32_t spheres(cdl_skd *t, uint32_t node, float *lo, float *hi)
             }
         next = node + 1;
     } else if ((nd.b & 3) == 3 && ((nd.b >> 2) & 3) == KIND_EMPTY) {
+        rg->lo = rg->hi = 0;
         next = node + 1;
     } else if ((nd.b & 3) == 3) { /* culling node: its child's samples */
         next = spheres(t, node + 1, lo, hi);
+        *rg = t->range[node + 1];
     } else {
         float l2[3], h2[3];
         spheres(t, node + 1, lo, hi);
         next = spheres(t, nd.b >> 2, l2, h2);
+        /* a subtree's samples are contiguous; an empty child has none */
+        cdl_skd_range a = t->range[node + 1], b = t->range[nd.b >> 2];
+        rg->lo = a.lo < a.hi ? a.lo : b.lo;
+        rg->hi = b.lo < b.hi ? b.hi : a.hi;
         for (int a = 0; a < 3; a++) {
             lo[a] = l2[a] < lo[a] ? l2[a] : lo[a];
             hi[a] = h2[a] > hi[a] ? h2[a] : hi[a];
@@ -331,7 +340,8 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
     }
     /* every node's bounding sphere */
     t->lsph = malloc(sizeof(float) * 4 * (t->nnodes ? t->nnodes : 1));
-    if (!t->lsph) {
+    t->range = malloc(sizeof(cdl_skd_range) * (t->nnodes ? t->nnodes : 1));
+    if (!t->lsph || !t->range) {
         cdl_skd_free(t);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
     }
@@ -353,12 +363,13 @@ void cdl_skd_free(cdl_skd *t)
     }
     free(t->parts);
     free(t->lsph);
+    free(t->range);
     memset(t, 0, sizeof *t);
 }
 
 size_t cdl_skd_bytes(const cdl_skd *t)
 {
-    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->nnodes * 4 * sizeof(float) + (size_t)t->n * (4 + 7 * sizeof(float)) +
+    return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->nnodes * (4 * sizeof(float) + sizeof(cdl_skd_range)) + (size_t)t->n * (4 + 7 * sizeof(float)) +
            (size_t)t->nparts * sizeof(cdl_skd_part);
 }
 
@@ -499,6 +510,11 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 }
 #endif
 
+uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz)
+{
+    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz) : weigh16(t, b, m, r, 0, w, iz);
+}
+
 typedef struct trav {
     const cdl_skd *t;
     const cdl_splat_ray *r;
@@ -636,6 +652,106 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
             return;
         }
     }
+}
+
+typedef struct region_walk {
+    const cdl_skd *t;
+    uint32_t max_n, n, cap, part;
+    cdl_skd_region *r;
+    int fail;
+} region_walk;
+
+static void regions_below(region_walk *w, uint32_t node)
+{
+    const cdl_skd *t = w->t;
+    for (;;) {
+        cdl_skd_range rg = t->range[node];
+        cdl_skd_node nd = t->nodes[node];
+        if (rg.hi <= rg.lo)
+            return;
+        if (rg.hi - rg.lo <= w->max_n || ((nd.b & 3) == 3 && ((nd.b >> 2) & 3) == KIND_LEAF)) {
+            if (w->n == w->cap) {
+                uint32_t cap = w->cap ? 2 * w->cap : 256;
+                cdl_skd_region *r = realloc(w->r, sizeof *r * cap);
+                if (!r) {
+                    w->fail = 1;
+                    return;
+                }
+                w->r = r;
+                w->cap = cap;
+            }
+            w->r[w->n++] = (cdl_skd_region){node, rg.lo, rg.hi, w->part};
+            return;
+        }
+        if ((nd.b & 3) == 3) { /* culling node */
+            node++;
+            continue;
+        }
+        regions_below(w, node + 1);
+        node = nd.b >> 2;
+    }
+}
+
+int cdl_skd_regions(const cdl_skd *t, uint32_t max_n, cdl_skd_region **out, uint32_t *n, cdl_error *err)
+{
+    region_walk w = {t, max_n ? max_n : 1, 0, 0, 0, NULL, 0};
+    for (uint32_t p = 0; p < t->nparts && !w.fail; p++) {
+        w.part = p;
+        regions_below(&w, t->parts[p].node);
+    }
+    if (w.fail) {
+        free(w.r);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the cache regions");
+    }
+    *out = w.r;
+    *n = w.n;
+    return 0;
+}
+
+typedef struct stop_trav {
+    trav v;
+    const int32_t *stop;
+    cdl_skd_visit_stop fn;
+    void *ctx;
+} stop_trav;
+
+static void traverse_stop(const stop_trav *s, uint32_t node)
+{
+    const trav *v = &s->v;
+    const cdl_skd *t = v->t;
+    for (;;) {
+        v->cnt->nodes++;
+        cdl_skd_node nd = t->nodes[node];
+        uint32_t kind = (nd.b >> 2) & 3;
+        if ((nd.b & 3) == 3 && kind == KIND_EMPTY)
+            return;
+        if (!((nd.b & 3) == 3 && kind == KIND_CULL) && !sphere_reached(v, node))
+            return;
+        if (s->stop[node] >= 0) {
+            s->fn(s->ctx, s->stop[node]);
+            return;
+        }
+        if ((nd.b & 3) == 3) {
+            if (kind == KIND_LEAF || !special_node(v, nd))
+                return;
+            node++;
+            continue;
+        }
+        traverse_stop(s, node + 1);
+        node = nd.b >> 2;
+    }
+}
+
+void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, const int32_t *stop,
+                        cdl_skd_visit_stop fn, void *ctx, cdl_skd_count *cnt)
+{
+    if (!t->n || part >= t->nparts)
+        return;
+    float hmax = radius_at(r, r->len);
+    stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, NULL, NULL, cnt},
+                   stop, fn, ctx};
+    traverse_stop(&s, t->parts[part].node);
 }
 
 int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,

@@ -27,6 +27,10 @@ typedef struct cdl_skd_node {
 
 enum { CDL_SKD_TWO_SIDED = 1 }; /* a sample that receives light from both sides (transmission) */
 
+typedef struct cdl_skd_range {
+    uint32_t lo, hi;
+} cdl_skd_range;
+
 typedef struct cdl_skd_part {
     uint32_t node, lo, hi; /* root node; samples [lo, hi) */
     float bmin[3], bmax[3];
@@ -39,7 +43,8 @@ typedef struct cdl_skd {
     uint32_t *order; /* caller's index of the sample at each tree position */
     float *p[3], *nrm[3];
     float *two; /* 1 for a two-sided sample, else 0 (the leaf test's arithmetic) */
-    float *lsph; /* per node: a leaf's bounding sphere (centre, radius) */
+    float *lsph;          /* per node: its samples' bounding sphere (centre, radius; -1 if none) */
+    cdl_skd_range *range; /* per node: its samples [lo, hi) (a subtree's are contiguous) */
     float bmin[3], bmax[3];
     cdl_skd_part *parts;
     uint32_t nparts;
@@ -103,8 +108,12 @@ typedef struct cdl_splat_hits {
 
 /* Weight of the sample at p (normal n, flags) for ray r (Algorithm 2):
  * 0 when infeasible: facing away, behind the origin surface, beyond the
- * frustum or the hemispherical cap. */
-static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec3 n, uint8_t flags, float *z_out)
+ * frustum or the hemispherical cap. With grad, also the weight's gradient
+ * with respect to the sample's position, the cosine held fixed (Herzog et
+ * al. 2007, eq. 6.9-6.11): -(4 / pi) cos / h^4 times the vector from the
+ * ray to the sample. */
+static inline float cdl_splat_weight_grad(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec3 n, uint8_t flags,
+                                          float *z_out, cdl_vec3 *grad)
 {
     float dn = cdl_dot(r->d, n), c = dn;
     if (flags & CDL_SKD_TWO_SIDED)
@@ -133,7 +142,14 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
     if (!(h2 > 0.0f) || r2 >= h2)
         return 0.0f;
     *z_out = z;
+    if (grad)
+        *grad = cdl_scale(e, (float)(-4.0 / CDL_PI) * -c / (h2 * h2));
     return (float)(2.0 / CDL_PI) / h2 * (1.0f - (r2 > 0.0f ? r2 : 0.0f) / h2) * -c;
+}
+
+static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec3 n, uint8_t flags, float *z_out)
+{
+    return cdl_splat_weight_grad(r, p, n, flags, z_out, NULL);
 }
 
 /* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
@@ -152,6 +168,28 @@ typedef struct cdl_skd_count {
 } cdl_skd_count;
 int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
                         void *ctx, cdl_skd_count *cnt);
+/* The leaf test alone (Algorithm 2) for samples [b, b + m), m <= 16, of
+ * any arrays laid out as the tree's p, nrm and two (16 floats of padding
+ * past the last): w and iz as a visit gets them; returns the mask of
+ * feasible lanes. */
+uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz);
+
+/* Regions: the top-most subtrees of each part holding at most max_n
+ * samples (a leaf of more counts as one), every sample in exactly one, in
+ * tree order (Herzog et al. 2007, §6.3: where radiance cache records are
+ * taken from). *out is allocated; 0 or an error. */
+typedef struct cdl_skd_region {
+    uint32_t node, lo, hi, part;
+} cdl_skd_region;
+int cdl_skd_regions(const cdl_skd *t, uint32_t max_n, cdl_skd_region **out, uint32_t *n, cdl_error *err);
+
+/* Traverses part `part` like cdl_skd_splat_visit (bounding spheres) but
+ * does not descend below a node with stop[node] >= 0: fn(ctx, stop[node])
+ * for each such node whose sphere the frustum reaches. */
+typedef void (*cdl_skd_visit_stop)(void *ctx, int32_t id);
+void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, const int32_t *stop,
+                        cdl_skd_visit_stop fn, void *ctx, cdl_skd_count *cnt);
+
 /* The same appended to out. Returns 0, or -1 out of memory. */
 int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_splat_hits *out);
 /* The same by testing every sample of the part one by one with
