@@ -7,7 +7,7 @@
 
 static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
                                "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max",
-                               "--cache", "--cache-min", "--cache-weight", "--cache-spacing"};
+                               "--cache", "--cache-min", "--cache-weight", "--cache-spacing", "--visibility-mask"};
 
 int cdl_splat_arg_kind(const char *o)
 {
@@ -90,6 +90,13 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
             sp->cache_geometric = 1;
         else
             rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected gradient or geometric, got '%s'", v);
+    } else if (!strcmp(o, "--visibility-mask")) {
+        if (!strcmp(v, "on"))
+            sp->visibility_mask = 1;
+        else if (!strcmp(v, "off"))
+            sp->visibility_mask = 0;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
     } else if (!strcmp(o, "--traversal")) {
         if (!strcmp(v, "sphere"))
             sp->slabs = 0;
@@ -142,6 +149,9 @@ void cdl_splat_args_help(void)
            "      --cache-weight KIND report (eq. 6.7; default) or ward (Ward 1988)\n"
            "      --cache-spacing KIND gradient (R shrunk where the splats' irradiance\n"
            "                          gradient is steep, eq. 6.12; default) or geometric\n"
+           "      --visibility-mask on|off  eye samples hidden from a photon ray by other eye\n"
+           "                          samples in its frustum get none of its light (§8.1;\n"
+           "                          default off; not with --cache)\n"
            "      --traversal KIND    how a photon ray finds its eye samples: sphere (each\n"
            "                          node's bounding sphere against the frustum; default) or\n"
            "                          slabs (the report's Algorithm 1: the same samples, about\n"

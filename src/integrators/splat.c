@@ -40,6 +40,11 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     if (opt->light_paths)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "splat traces photon paths until its budgets are full: use --photons");
+    if (o->visibility_mask && o->cache > 0.0f)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--visibility-mask", 0,
+                             "works without --cache (records are splatted without masks)");
+    if (o->visibility_mask && splat_mask_alloc(s, SPLAT_MASK_BATCH, err))
+        return err->code;
     if (opt->interleave > 1)
         return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "splat does not interleave light paths");
     if (!scene->nlights)
@@ -255,6 +260,7 @@ static size_t bytes(const splat_state *s)
 {
     return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
            cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
+           splat_mask_bytes(s, SPLAT_MASK_BATCH) +
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
 }
 
@@ -296,8 +302,10 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
         if (rc)
             return rc;
     } else {
-        splat_maps_splat(s);
+        rc = splat_maps_splat(s);
         s->st.t_solve += cdl_time_now() - t3;
+        if (rc)
+            return cdl_error_set(err, rc, "splat", 0, "out of memory for the visibility masks");
     }
     double t4 = cdl_time_now();
     if (cdl_cancel)
@@ -378,6 +386,12 @@ static void splat_report(const void *self)
            (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_cache, t->t_brdf,
            s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
     splat_cache_report(s);
+    if (s->mask)
+        printf("splat: visibility mask: %.1f eye samples rasterized and %.1f tested per photon ray, %.1f %% of the "
+               "feasible splats masked\n",
+               t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
+               t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
+               t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);
     if (s->opt.splat.filter > 0.0f)
         printf("splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
                (double)t->segments / P);
@@ -407,6 +421,7 @@ static void splat_destroy(void *self)
     free(s->gmap);
     free(s->bw);
     splat_cache_free(s);
+    splat_mask_free(s);
     free(s->tables);
 }
 

@@ -29,7 +29,7 @@ typedef struct splat_eye {
 typedef struct splat_stats {
     double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_total;
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
-    uint64_t records, cache_passes, ray_refs;
+    uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized;
     size_t peak_bytes;
 } splat_stats;
 
@@ -64,6 +64,7 @@ typedef struct splat_state {
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
     float *bw;        /* --aov bandwidth only: SPLAT_BW floats per sample */
     struct splat_cache *cache; /* --cache: radiance caching (splat_cache.c) */
+    struct splat_mask *mask;   /* --visibility-mask (splat_mask.c) */
     int want_bw;
     cdl_vec3 strata[SPLAT_STRATA];
     cdl_sh_rot rot;
@@ -91,8 +92,9 @@ int splat_maps_init(splat_state *s, cdl_error *err);
 /* Sizes the maps for this pass's eye samples (after the tree is built). */
 int splat_maps_alloc(splat_state *s, cdl_error *err);
 size_t splat_maps_bytes(const splat_state *s);
-/* Splats every photon ray into the maps, part by part on all threads. */
-void splat_maps_splat(splat_state *s);
+/* Splats every photon ray into the maps, part by part on all threads;
+ * 0 or CDL_ERR_SYSTEM (no memory for the visibility masks). */
+int splat_maps_splat(splat_state *s);
 /* Each eye sample's reflected radiance, weighted, into s->pix. */
 void splat_maps_resolve(splat_state *s);
 /* Radiance caching (§6.3, splat_cache.c): the maps computed at a sparse
@@ -103,6 +105,17 @@ void splat_cache_free(splat_state *s);
 void splat_cache_report(const splat_state *s);
 /* --aov records for sample q: 1 at a record, records gathered, |grad E|; 0 without a cache. */
 int splat_cache_aov(const splat_state *s, uint32_t q, float out[3]);
+/* The visibility mask (§8.1, splat_mask.c): the rays' occlusion buffers
+ * built a batch at a time; filter drops from a batch's mask the samples
+ * ray `ray`'s buffer hides (iz: one over their distance along it). */
+#define SPLAT_MASK_BATCH 8192u
+typedef struct splat_mask splat_mask;
+int splat_mask_alloc(splat_state *s, uint32_t batch, cdl_error *err);
+void splat_mask_free(splat_state *s);
+size_t splat_mask_bytes(const splat_state *s, uint32_t batch);
+int splat_mask_prepare(splat_state *s);
+int splat_mask_build(splat_state *s, uint32_t first, uint32_t n);
+uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, uint32_t mask, const float *iz);
 /* Filters the maps in image space within surface segments (§6.2, splat_filter.c). */
 int splat_filter(splat_state *s, cdl_error *err);
 /* RGB of entry k (stratum or coefficient) of glossy sample g. */

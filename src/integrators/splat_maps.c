@@ -184,7 +184,8 @@ void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float i
 typedef struct ray_ctx {
     splat_state *s;
     splat_terms t;
-    uint64_t splats;
+    uint32_t ray;
+    uint64_t splats, masked;
 } ray_ctx;
 
 /* The feasible glossy samples of a batch: the ray's light in their maps. */
@@ -224,6 +225,12 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
 {
     ray_ctx *c = ctx;
     splat_state *s = c->s;
+    if (s->mask) {
+        uint32_t seen = splat_mask_filter(s, c->ray, first, mask, iz);
+        c->masked += (uint64_t)__builtin_popcount(mask & ~seen);
+        if (!(mask = seen))
+            return;
+    }
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
     float *ws = s->wsum + first, *zs = s->izsum + first, *ns = s->nsum + first;
     const uint32_t *gl = s->gloss + first;
@@ -274,31 +281,44 @@ void splat_maps_clear(splat_state *s)
         memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
 }
 
-void splat_maps_splat(splat_state *s)
+int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
-    uint64_t splats = 0, tested = 0, nodes = 0;
+    uint64_t splats = 0, tested = 0, nodes = 0, masked = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes)
-    for (uint32_t part = 0; part < s->tree.nparts; part++) {
-        cdl_skd_count cnt = {0, 0};
-        ray_ctx c;
-        c.s = s;
-        c.splats = 0;
-        for (uint32_t k = 0; k < s->rays.n && !cdl_cancel; k++) {
-            const cdl_photon_ray *r = &s->rays.r[k];
-            cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
-            c.t.r = r;
-            c.t.ready = 0;
-            cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
+    /* with visibility masks, a batch of rays at a time: masks first */
+    uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
+    if (s->mask && splat_mask_prepare(s))
+        return CDL_ERR_SYSTEM;
+    for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancel; k0 += batch) {
+        uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
+        if (s->mask)
+            splat_mask_build(s, k0, k1 - k0);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, masked)
+        for (uint32_t part = 0; part < s->tree.nparts; part++) {
+            cdl_skd_count cnt = {0, 0};
+            ray_ctx c;
+            c.s = s;
+            c.splats = c.masked = 0;
+            for (uint32_t k = k0; k < k1 && !cdl_cancel; k++) {
+                const cdl_photon_ray *r = &s->rays.r[k];
+                cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+                c.t.r = r;
+                c.t.ready = 0;
+                c.ray = k;
+                cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
+            }
+            splats += c.splats;
+            masked += c.masked;
+            tested += cnt.tested;
+            nodes += cnt.nodes;
         }
-        splats += c.splats;
-        tested += cnt.tested;
-        nodes += cnt.nodes;
     }
     s->st.splats += splats;
+    s->st.masked += masked;
     s->st.tested += tested;
     s->st.nodes += nodes;
+    return 0;
 }
 
 /* The stratum's centre, moved just above the horizon of n if it lies

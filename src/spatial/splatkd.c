@@ -520,15 +520,49 @@ typedef struct trav {
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
-    int cull, slabs;
+    int cull, slabs, any;
     cdl_skd_visit fn;
     void *ctx;
     cdl_skd_count *cnt;
 } trav;
 
+/* CDL_SKD_ANY's leaf test: inside the frustum, any facing; zz gets z. */
+static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float zmax, float *w,
+                          float *zz)
+{
+    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
+    const float len = r->len, h0 = r->h0, dh = r->dh;
+    const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
+    uint32_t ok[16];
+#pragma omp simd
+    for (uint32_t i = 0; i < 16; i++) {
+        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
+        float z = Dx * dx + Dy * dy + Dz * dz;
+        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
+        float h = h0 + dh * (z < len ? z : len);
+        ok[i] = (z >= 0.0f) & (z <= zmax) & (ex * ex + ey * ey + ez * ez < h * h) & (i < m);
+        zz[i] = z;
+        w[i] = 0.0f;
+    }
+    uint32_t mask = 0;
+    for (uint32_t i = 0; i < 16; i++)
+        mask |= ok[i] << i;
+    return mask;
+}
+
 static void test_range(const trav *v, uint32_t lo, uint32_t hi)
 {
     v->cnt->tested += hi - lo;
+    if (v->any) {
+        for (uint32_t b = lo; b < hi; b += 16) {
+            uint32_t m = hi - b < 16 ? hi - b : 16;
+            float w[16], zz[16];
+            uint32_t in = frustum16(v->t, b, m, v->r, v->zmax, w, zz);
+            if (in)
+                v->fn(v->ctx, b, m, in, w, zz);
+        }
+        return;
+    }
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
@@ -749,7 +783,7 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, NULL, NULL, cnt},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
@@ -768,8 +802,18 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         mn = t->parts[part].bmin;
         mx = t->parts[part].bmax;
     }
-    trav v = {t,   r,   {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f}, 0.0f,
-              (flags & CDL_SKD_CULL) != 0, (flags & CDL_SKD_SLABS) != 0, fn, ctx, cnt};
+    trav v = {t,
+              r,
+              {r->o.x, r->o.y, r->o.z},
+              {r->d.x, r->d.y, r->d.z},
+              {0.0f, 0.0f, 0.0f},
+              0.0f,
+              (flags & (CDL_SKD_CULL | CDL_SKD_ANY)) == CDL_SKD_CULL,
+              (flags & CDL_SKD_SLABS) != 0,
+              (flags & CDL_SKD_ANY) != 0,
+              fn,
+              ctx,
+              cnt};
     for (int a = 0; a < 3; a++)
         v.inv[a] = v.d[a] != 0.0f ? 1.0f / fabsf(v.d[a]) : 0.0f;
     /* clip [0, len + cap h(len)] by the box grown by the largest radius */

@@ -155,7 +155,11 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 /* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
  * report's traversal) instead of the default bounding-sphere test per
  * node (the same samples, fewer tested). */
-enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2 };
+enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_ANY = 4 };
+/* CDL_SKD_ANY: every sample inside the frustum (within h of the ray, 0 <=
+ * z up to the cap's reach) whatever its facing, as the occluders of a
+ * visibility mask see them: the visit's mask holds them, w is 0 and iz[i]
+ * is z itself; culling nodes are not honoured. */
 
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
