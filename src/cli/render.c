@@ -149,6 +149,8 @@ int cdl_render_parse(int argc, char **argv, render_args *a, cdl_error *err)
             a->photons_given = 1;
         if (!strcmp(o, "--direct"))
             a->direct_given = 1;
+        if (!strcmp(o, "--gather"))
+            a->gather_given = 1;
         if (cdl_gkde_arg_kind(o)) {
             if (i + 1 >= argc)
                 return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");
@@ -420,6 +422,8 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
     opt->splat = a->splat;
     if (a->photons_given)
         opt->splat.photons = a->pm.photons;
+    if (a->gather_given)
+        opt->splat.gather = a->pm.gather;
     if (a->direct_given)
         opt->splat.direct_sample = !a->pm.direct_photons && a->pm.direct != CDL_DIRECT_NONE;
     if (a->direct_given && a->pm.direct == CDL_DIRECT_NONE)

@@ -33,7 +33,7 @@ typedef struct render_args {
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;
-    int photons_given, direct_given; /* shared with pm: splat takes them only if given */
+    int photons_given, direct_given, gather_given; /* shared with pm: splat takes them only if given */
     /* given on the command line (else the scene file or the default decides) */
     int has_integrator, has_res, has_fov, has_maxdepth;
 } render_args;

@@ -73,6 +73,7 @@ typedef struct cdl_splat_options {
     uint32_t cache_min;  /* records every pixel gathers from, N_c */
     int cache_ward;      /* Ward's weight instead of the report's (eq. 6.7), for comparison */
     int cache_geometric; /* record spacing from the harmonic mean distance alone (no irradiance gradient) */
+    uint32_t gather;     /* §6.4: final-gather rays per camera sample, each an eye sample; 0: none */
     int visibility_mask; /* §8.1: eye samples hidden from a photon ray by others in its frustum get nothing */
     float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
                           * test out to c h (spatial/splatkd.h) */

@@ -82,8 +82,23 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     s->kp.part_depth = 4;
     if (!o->cull)
         s->kp.cull_deg = -1.0f;
+    if (o->gather && (o->cache > 0.0f || o->filter > 0.0f || o->mode != CDL_SPLAT_DIRECT))
+        return cdl_error_set(err, CDL_ERR_USAGE, "--gather", 0,
+                             "final gathering splats to the gather rays' hits directly: no --cache, --filter "
+                             "or --mode histogram|sh");
     size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;
-    s->nslots = (uint32_t)(npix * o->eye_samples);
+    /* final gathering: G eye samples per camera sample, in bands of rows
+     * holding at most SPLAT_BAND_SLOTS (the report renders tiles) */
+    s->G = o->gather ? o->gather : 1;
+    size_t row = (size_t)opt->camera.width * o->eye_samples * s->G;
+    s->band_rows = o->gather ? (int)(SPLAT_BAND_SLOTS / row) : opt->camera.height;
+    if (s->band_rows < 1)
+        s->band_rows = 1;
+    if (s->band_rows > opt->camera.height)
+        s->band_rows = opt->camera.height;
+    if (row * (size_t)s->band_rows > UINT32_MAX / 2)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--res", 0, "too many eye samples per pass");
+    s->nslots = (uint32_t)(row * (size_t)s->band_rows);
     s->base = calloc(npix, sizeof *s->base);
     s->dz = calloc(npix, sizeof *s->dz);
     s->dn = calloc(npix, sizeof *s->dn);
@@ -98,20 +113,82 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     return splat_maps_init(s, err);
 }
 
-/* Step 1 for pixel row y: its eye samples into their slots. */
-static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *dc, cdl_lcon_scratch *lc,
+/* An eye sample at v into slot k: its pixel, weight and footprint pw. */
+static void fill_slot(splat_state *s, uint32_t k, const cdl_visible *v, cdl_vec3 weight, uint32_t p, float pw)
+{
+    splat_eye *e = &s->slot[k];
+    e->b = v->b;
+    e->weight = weight;
+    e->wo = v->wo;
+    e->pixel = p;
+    e->mat = v->sf.mat;
+    e->pw = pw;
+    cdl_vec3 ng = cdl_dot(v->sf.ng, v->wo) < 0.0f ? cdl_neg(v->sf.ng) : v->sf.ng;
+    cdl_vec3 n = v->b.frame.n;
+    if (cdl_dot(n, v->wo) < 0.0f)
+        n = cdl_neg(n);
+    cdl_vec3 t = cdl_sub(v->wo, cdl_scale(n, cdl_dot(v->wo, n)));
+    float tl = cdl_length(t);
+    cdl_frame f = cdl_frame_from(n);
+    if (tl > 1e-6f) {
+        f.t = cdl_scale(t, 1.0f / tl);
+        f.b = cdl_cross(n, f.t);
+    }
+    e->f = f;
+    s->sp[k] = v->sf.p;
+    s->sn[k] = ng;
+    s->sflags[k] = v->b.type == CDL_MAT_ROUGH_DIELECTRIC ? CDL_SKD_TWO_SIDED : 0;
+    s->svalid[k] = 1;
+}
+
+/* Final gathering from the camera's point v (§6.4): G rays by BSDF
+ * sampling, each an eye sample where it lands (after specular surfaces)
+ * weighing what the photon rays bring there; emission a gather ray meets
+ * after a specular bounce is a caustic path no photon estimate holds, so
+ * it goes to the pixel; emission it meets first is the light sampled at v. */
+static cdl_vec3 gather(splat_state *s, const cdl_visible *v, cdl_vec3 w, uint32_t k0, uint32_t p, cdl_sampler *smp,
+                       uint64_t *rays)
+{
+    const cdl_scene *sc = s->scene;
+    uint32_t G = s->opt.splat.gather;
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    /* a gather ray's share of the hemisphere, as a footprint (for masks) */
+    float spread = sqrtf(2.0f * (float)CDL_PI / (float)G);
+    for (uint32_t g = 0; g < G; g++) {
+        cdl_scatter sct;
+        float u0 = cdl_sampler_1d(smp), u1, u2;
+        cdl_sampler_2d(smp, &u1, &u2);
+        if (!cdl_bsdf_sample(&v->b, v->wo, u0, u1, u2, 0, &sct) || cdl_is_black(sct.weight))
+            continue;
+        cdl_vec3 wg = cdl_scale(cdl_mul(w, sct.weight), 1.0f / (float)G);
+        cdl_visible vg;
+        int hit = cdl_find_visible(sc, cdl_offset(sc, v->sf.p, v->sf.ng, sct.wi), sct.wi, s->opt.maxdepth - 1, smp,
+                                   rays, &vg);
+        if (vg.depth > 0)
+            L = cdl_add(L, cdl_mul(wg, vg.L));
+        if (hit)
+            fill_slot(s, k0 + g, &vg, cdl_mul(wg, vg.beta), p, vg.dist * spread);
+    }
+    return L;
+}
+
+/* Step 1 for pixel row y: its eye samples into their slots (slots count
+ * from the band's first row y0; s->G per camera sample: gather rays or 1). */
+static void eye_row(splat_state *s, int y, int y0, uint32_t pass, const cdl_direct_cfg *dc, cdl_lcon_scratch *lc,
                     uint64_t *rays)
 {
     const cdl_camera *cam = &s->opt.camera;
     const cdl_scene *sc = s->scene;
-    uint32_t E = s->opt.splat.eye_samples;
+    uint32_t E = s->opt.splat.eye_samples, G = s->G;
+    int direct = s->opt.splat.direct_sample || s->opt.splat.gather;
     for (int x = 0; x < cam->width; x++) {
         uint32_t p = (uint32_t)y * (uint32_t)cam->width + (uint32_t)x;
+        uint32_t pb = p - (uint32_t)y0 * (uint32_t)cam->width;
         cdl_vec3 base = cdl_v3(0.0f, 0.0f, 0.0f);
         s->dz[p] = 0.0f;
         for (uint32_t j = 0; j < E; j++) {
-            uint32_t k = p * E + j;
-            s->svalid[k] = 0;
+            uint32_t k = p * E + j, k0 = (pb * E + j) * G;
+            memset(s->svalid + k0, 0, G);
             cdl_sampler smp;
             float jx, jy;
             cdl_sampler_start(&smp, s->opt.sampler, s->opt.seed, k, pass);
@@ -122,46 +199,29 @@ static void eye_row(splat_state *s, int y, uint32_t pass, const cdl_direct_cfg *
             base = cdl_add(base, v.L);
             if (!hit)
                 continue;
-            if (s->opt.splat.direct_sample) {
+            if (direct) {
                 uint32_t nl = 0;
                 cdl_vec3 Ld = cdl_direct_light(sc, dc, lc, &v.sf, &v.b, v.wo, &smp, rays, &nl);
                 base = cdl_add(base, cdl_mul(v.beta, Ld));
             }
-            splat_eye *e = &s->slot[k];
-            e->b = v.b;
-            e->weight = cdl_scale(v.beta, 1.0f / (float)E);
-            e->wo = v.wo;
-            e->pixel = p;
-            e->mat = v.sf.mat;
-            e->pw = v.dist * 2.0f * cam->tan_half / (float)cam->height;
-            cdl_vec3 ng = cdl_dot(v.sf.ng, v.wo) < 0.0f ? cdl_neg(v.sf.ng) : v.sf.ng;
-            cdl_vec3 n = v.b.frame.n;
-            if (cdl_dot(n, v.wo) < 0.0f)
-                n = cdl_neg(n);
-            cdl_vec3 t = cdl_sub(v.wo, cdl_scale(n, cdl_dot(v.wo, n)));
-            float tl = cdl_length(t);
-            cdl_frame f = cdl_frame_from(n);
-            if (tl > 1e-6f) {
-                f.t = cdl_scale(t, 1.0f / tl);
-                f.b = cdl_cross(n, f.t);
+            cdl_vec3 w = cdl_scale(v.beta, 1.0f / (float)E);
+            if (s->opt.splat.gather) {
+                if (v.depth + 1 < s->opt.maxdepth)
+                    base = cdl_add(base, cdl_scale(gather(s, &v, w, k0, p, &smp, rays), (float)E));
+                continue;
             }
-            e->f = f;
-            s->sp[k] = v.sf.p;
-            s->sn[k] = ng;
-            s->sflags[k] = v.b.type == CDL_MAT_ROUGH_DIELECTRIC ? CDL_SKD_TWO_SIDED : 0;
-            s->svalid[k] = 1;
+            fill_slot(s, k0, &v, w, p, v.dist * 2.0f * cam->tan_half / (float)cam->height);
             if (s->dz[p] == 0.0f) { /* the discontinuity buffer: the pixel's first sample */
                 s->dz[p] = v.dist * cdl_dot(dir, cam->fwd);
-                s->dn[p] = f.n;
+                s->dn[p] = s->slot[k0].f.n;
             }
         }
         s->base[p] = cdl_scale(base, 1.0f / (float)E);
     }
 }
 
-static int eye_pass(splat_state *s, uint32_t pass, uint64_t *rays, cdl_error *err)
+static int eye_pass(splat_state *s, uint32_t pass, int y0, int y1, uint64_t *rays, cdl_error *err)
 {
-    const cdl_camera *cam = &s->opt.camera;
     uint64_t r = 0;
     int fail = 0;
 #pragma omp parallel reduction(+ : r)
@@ -170,9 +230,9 @@ static int eye_pass(splat_state *s, uint32_t pass, uint64_t *rays, cdl_error *er
         int ok = cdl_lcon_scratch_init(&lc, s->scene->nlights) == 0;
         cdl_direct_cfg dc = {CDL_DIRECT_POWER, 1, NULL, 0.0f};
 #pragma omp for schedule(dynamic, 4)
-        for (int y = 0; y < cam->height; y++)
+        for (int y = y0; y < y1; y++)
             if (ok)
-                eye_row(s, y, pass, &dc, &lc, &r);
+                eye_row(s, y, y0, pass, &dc, &lc, &r);
         if (!ok) {
 #pragma omp atomic write
             fail = 1;
@@ -184,8 +244,8 @@ static int eye_pass(splat_state *s, uint32_t pass, uint64_t *rays, cdl_error *er
     if (fail)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory");
     /* the valid slots, in slot order, become the eye samples */
-    uint32_t n = 0;
-    for (uint32_t k = 0; k < s->nslots; k++)
+    uint32_t n = 0, nk = (uint32_t)(y1 - y0) * (uint32_t)s->opt.camera.width * s->opt.splat.eye_samples * s->G;
+    for (uint32_t k = 0; k < nk; k++)
         if (s->svalid[k]) {
             s->slot[n] = s->slot[k];
             s->sp[n] = s->sp[k];
@@ -264,21 +324,11 @@ static size_t bytes(const splat_state *s)
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
 }
 
-static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+/* Step 3: this pass's photon rays, sorted (the same for every band). */
+static int photon_rays(splat_state *s, cdl_film *film, uint32_t pass, cdl_error *err)
 {
-    splat_state *s = self;
     double t0 = cdl_time_now();
-    int a_bw = cdl_film_find_aov(film, "bandwidth");
-    s->want_bw = a_bw >= 0;
-    int rc = eye_pass(s, pass, &film->rays, err);
-    double t1 = cdl_time_now();
-    s->st.t_ray += t1 - t0;
-    if (!rc)
-        rc = build(s, err);
-    double t2 = cdl_time_now();
-    s->st.t_build += t2 - t1;
-    if (rc || cdl_cancel)
-        return rc;
+    int rc;
     if (!s->have_pilot) {
         rc = cdl_pray_pilot(s->scene, &s->walk, s->opt.sampler, s->opt.seed, PILOT_PATHS, s->pp.S, s->pp.d2_clamp,
                             &s->pp.w, &s->pp.mu, err);
@@ -288,36 +338,67 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     }
     s->pp.m_scale = (double)pass + 1.0;
     rc = cdl_pray_trace(s->scene, &s->walk, &s->pp, s->opt.sampler, s->opt.seed, pass, &s->rays, err);
-    if (rc)
-        return rc;
-    rc = sort_rays(s, err);
+    if (!rc)
+        rc = sort_rays(s, err);
     if (rc)
         return rc;
     film->rays += s->rays.rays;
     s->st.rays_stored += s->rays.n;
-    double t3 = cdl_time_now();
-    s->st.t_light += t3 - t2;
+    s->st.t_light += cdl_time_now() - t0;
+    return 0;
+}
+
+/* --aov bandwidth: per pixel the mean bandwidth of the rays that splatted
+ * it, by the rays' depth (2, 3, any), weighted by their kernels. */
+static int bandwidth_aov(splat_state *s, cdl_film *film, int a_bw, cdl_error *err)
+{
+    size_t npix = (size_t)s->opt.camera.width * (size_t)s->opt.camera.height;
+    double *acc = calloc(npix * 6, sizeof(double));
+    if (!acc)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
+    for (uint32_t q = 0; q < s->neye; q++)
+        for (int k = 0; k < 6; k++)
+            acc[6 * (size_t)s->eye[q].pixel + k] += s->bw[(size_t)q * SPLAT_BW + k];
+    for (size_t p = 0; p < npix; p++)
+        for (int c = 0; c < 3; c++) {
+            double w = acc[6 * p + 2 * c + 1];
+            film->aovs[a_bw].sum[3 * p + c] += w > 0.0 ? acc[6 * p + 2 * c] / w : 0.0;
+        }
+    free(acc);
+    return 0;
+}
+
+/* One band of rows [y0, y1) (the whole image unless final gathering makes
+ * too many eye samples): eye pass, tree, splats, radiance into s->pix. */
+static int band(splat_state *s, cdl_film *film, uint32_t pass, int y0, int y1, cdl_error *err)
+{
+    double t0 = cdl_time_now();
+    int rc = eye_pass(s, pass, y0, y1, &film->rays, err);
+    double t1 = cdl_time_now();
+    s->st.t_ray += t1 - t0;
+    if (!rc)
+        rc = build(s, err);
+    double t2 = cdl_time_now();
+    s->st.t_build += t2 - t1;
+    if (rc || cdl_cancel)
+        return rc;
     if (s->opt.splat.cache > 0.0f) {
         rc = splat_cache_solve(s, err); /* counts its own T_solve and T_cache */
         if (rc)
             return rc;
     } else {
         rc = splat_maps_splat(s);
-        s->st.t_solve += cdl_time_now() - t3;
+        s->st.t_solve += cdl_time_now() - t2;
         if (rc)
             return cdl_error_set(err, rc, "splat", 0, "out of memory for the visibility masks");
     }
-    double t4 = cdl_time_now();
+    double t3 = cdl_time_now();
     if (cdl_cancel)
-        return 0; /* an interrupted pass adds nothing */
-    const cdl_camera *cam = &s->opt.camera;
-    size_t npix = (size_t)cam->width * (size_t)cam->height;
-    memset(s->pix, 0, sizeof *s->pix * npix);
-    double tf = cdl_time_now();
+        return 0;
     rc = splat_filter(s, err);
     if (rc)
         return rc;
-    s->st.t_filter += cdl_time_now() - tf;
+    s->st.t_filter += cdl_time_now() - t3;
     int a_rec = cdl_film_find_aov(film, "records");
     if (a_rec >= 0) /* before the maps become radiance */
         for (uint32_t q = 0; q < s->neye; q++) {
@@ -328,30 +409,39 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
                         v[c] / (float)s->opt.splat.eye_samples;
         }
     splat_maps_resolve(s);
+    s->st.samples += s->neye;
+    s->st.t_brdf += cdl_time_now() - t3;
+    return 0;
+}
+
+static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+{
+    splat_state *s = self;
+    double t0 = cdl_time_now();
+    int a_bw = cdl_film_find_aov(film, "bandwidth");
+    if (a_bw >= 0 && s->opt.splat.gather)
+        return cdl_error_set(err, CDL_ERR_USAGE, "--aov", 0, "bandwidth is not available with --gather");
+    s->want_bw = a_bw >= 0;
+    int rc = photon_rays(s, film, pass, err);
+    if (rc)
+        return rc;
+    const cdl_camera *cam = &s->opt.camera;
+    size_t npix = (size_t)cam->width * (size_t)cam->height;
+    memset(s->pix, 0, sizeof *s->pix * npix);
+    for (int y0 = 0; y0 < cam->height && !rc && !cdl_cancel; y0 += s->band_rows)
+        rc = band(s, film, pass, y0, y0 + s->band_rows < cam->height ? y0 + s->band_rows : cam->height, err);
+    if (rc || cdl_cancel)
+        return rc; /* an interrupted pass adds nothing */
+    double t4 = cdl_time_now();
     uint64_t bad = 0;
     for (size_t p = 0; p < npix; p++)
         bad += (uint64_t)cdl_film_add(film, (int)(p % (size_t)cam->width), (int)(p / (size_t)cam->width),
                                       cdl_add(s->base[p], s->pix[p]));
     film->nonfinite += bad;
-    if (a_bw >= 0) {
-        /* per pixel: the mean bandwidth of the rays that splatted it, by
-         * the rays' depth (2, 3, any), weighted by their kernels */
-        double *acc = calloc(npix * 6, sizeof(double));
-        if (!acc)
-            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
-        for (uint32_t q = 0; q < s->neye; q++)
-            for (int k = 0; k < 6; k++)
-                acc[6 * (size_t)s->eye[q].pixel + k] += s->bw[(size_t)q * SPLAT_BW + k];
-        for (size_t p = 0; p < npix; p++)
-            for (int c = 0; c < 3; c++) {
-                double w = acc[6 * p + 2 * c + 1];
-                film->aovs[a_bw].sum[3 * p + c] += w > 0.0 ? acc[6 * p + 2 * c] / w : 0.0;
-            }
-        free(acc);
-    }
+    if (a_bw >= 0 && (rc = bandwidth_aov(s, film, a_bw, err)))
+        return rc;
     double t5 = cdl_time_now();
     s->st.t_brdf += t5 - t4;
-    s->st.samples += s->neye;
     s->st.passes++;
     s->st.t_total += t5 - t0;
     size_t b = bytes(s);

@@ -14,6 +14,7 @@
 #define SPLAT_STRATA 20 /* icosahedron faces */
 #define SPLAT_BW 6       /* --aov bandwidth: weighted bandwidth and weight at depth 2, 3, any */
 #define SPLAT_LAMBERT UINT32_MAX
+#define SPLAT_BAND_SLOTS (1u << 20) /* eye samples per band with --gather */
 
 /* An eye sample (§3): what the final step needs besides the tree's
  * position and normal. */
@@ -45,6 +46,8 @@ typedef struct splat_state {
     uint8_t *sflags, *svalid;
     splat_eye *slot, *eye;
     uint32_t nslots, neye;
+    uint32_t G;       /* eye samples per camera sample: --gather rays, or 1 */
+    int band_rows;    /* rows per band (the whole image without --gather) */
     cdl_vec3 *base;   /* per pixel: emission seen and direct light sampled, this pass */
     float *dz;        /* discontinuity buffer, per pixel: view depth of its first eye sample (0: none) */
     cdl_vec3 *dn;     /* and the normal of the side seen */
