@@ -3,7 +3,9 @@
 # standing in for Sibenik; its Mitsuba light as a point light), photon ray
 # splatting (SH maps) against the photon map seen directly with K nearest
 # photons (K chosen for a similar radius), both with the same number of
-# photons and one eye sample per pixel, against a converged path-traced
+# photons and one eye sample per pixel, and (the report's (d)) splat with
+# radiance caching and image-space filtering (--cache 0.5 --filter 20000, the
+# cache rows' smaller C and S), against a converged path-traced
 # reference of indirect light: path at maxdepth D minus path at maxdepth 1
 # with the same seed (the direct light cancels sample by sample).
 # Relative error maps (blue < 5 %, green 15 %, red >= 30 %, as the report)
@@ -31,12 +33,14 @@ if [ "${SCENE:-sponza}" = cornell ]; then
   args=("$here/../shared/scenes/cornell-box-mcguire/CornellBox-Original.obj" --lookat 0,1,3.9,0,1,0,0,1,0
     --fov 39.3077 --res "$res" --maxdepth $depth)
   splat_opts=()
+  cache_opts=(--mode sh -C 0.6 -S 0.2 --cache 0.5 --filter 20000)
   png=$out/fig72.png
 else
   args=("$here/../shared/scenes/sponza-dabrovic/obj-converted/sponza.obj"
     --lookat 14.4499,6.89415,-1.18547,13.4563,6.78438,-1.15861,-0.109708,0.993957,0.00374357 --fov 75
     --point-light 0,17,0,157,157,157 --res "$res" --maxdepth $depth)
   splat_opts=(--mode sh --fractions 0,1,0 -C 0.9 -S 0.3 -R 0.2)
+  cache_opts=(--mode sh --fractions 0,1,0 -C 0.5 -S 0.2 -R 0.2 --cache 0.5 --filter 20000)
   png=$here/docs/splat-fig72.png
 fi
 for d in $depth 1; do
@@ -45,6 +49,8 @@ for d in $depth 1; do
 done
 "$candela" render "${args[@]}" -i splat --direct none "${splat_opts[@]}" --photons "$photons" --spp "$passes" \
   -o "$out/splat.exr" | tee "$out/splat.log"
+"$candela" render "${args[@]}" -i splat --direct none "${cache_opts[@]}" --photons "$photons" --spp "$passes" \
+  -o "$out/cache.exr" | tee "$out/cache.log"
 "$candela" render "${args[@]}" -i pm --direct none --gather 0 --knn "$k" --photons "$photons" --spp "$passes" \
   -o "$out/pm.exr" | tee "$out/pm.log"
 /usr/bin/python3 - "$out" "$png" "${SCENE:-sponza}" <<'EOF'
@@ -76,7 +82,7 @@ floor = 0.05 * r.mean()
 seen_light = lum(direct) > 1.0 if scene == "cornell" else np.zeros(r.shape, bool)
 valid = (r > floor) & ~seen_light
 rows, panels = [], [("path, indirect light", ref, None)]
-for name, label in (("splat", "splat (SH)"), ("pm", "pm, K nearest")):
+for name, label in (("splat", "splat (SH)"), ("cache", "splat (SH), cache + filter"), ("pm", "pm, K nearest")):
     t = load(name)
     rel = np.abs(lum(t) - r) / np.maximum(r, floor)
     e = (lum(t) - r) ** 2 / (r ** 2 + 0.01)

@@ -1014,6 +1014,361 @@ def building():
     return s
 
 
+# --- finely tessellated furniture (conference_fg) ---------------------------------
+
+class _Xf:
+    """An affine map p -> M p + t with M a rotation (so normals map by M too)."""
+
+    def __init__(self, m=((1, 0, 0), (0, 1, 0), (0, 0, 1)), t=(0, 0, 0)):
+        self.m, self.t = m, t
+
+    def p(self, q):
+        m, t = self.m, self.t
+        return tuple(m[i][0] * q[0] + m[i][1] * q[1] + m[i][2] * q[2] + t[i] for i in range(3))
+
+    def n(self, q):
+        m = self.m
+        return tuple(m[i][0] * q[0] + m[i][1] * q[1] + m[i][2] * q[2] for i in range(3))
+
+    def then(self, b):
+        """self first, then b"""
+        m = tuple(tuple(sum(b.m[i][k] * self.m[k][j] for k in range(3)) for j in range(3))
+                  for i in range(3))
+        return _Xf(m, b.p(self.t))
+
+    @staticmethod
+    def move(x, y, z):
+        return _Xf(t=(x, y, z))
+
+    @staticmethod
+    def yaw(deg, pivot=(0, 0, 0)):
+        """about the vertical axis through pivot, counter-clockwise seen from above
+        (as Scene.box's rot: +x turns towards -z for deg > 0)"""
+        a = math.radians(deg)
+        ca, sa = math.cos(a), math.sin(a)
+        r = _Xf(((ca, 0, sa), (0, 1, 0), (-sa, 0, ca)))
+        return _Xf.move(*(-c for c in pivot)).then(r).then(_Xf.move(*pivot))
+
+    @staticmethod
+    def pitch(deg, pivot=(0, 0, 0)):
+        """about the x axis through pivot; deg > 0 turns +y towards +z"""
+        a = math.radians(deg)
+        ca, sa = math.cos(a), math.sin(a)
+        r = _Xf(((1, 0, 0), (0, ca, -sa), (0, sa, ca)))
+        return _Xf.move(*(-c for c in pivot)).then(r).then(_Xf.move(*pivot))
+
+
+def _tri_n(s, xf, a, b, c, na, nb, nc, mtl):
+    """A triangle in xf's local frame with vertex normals, wound counter-clockwise
+    seen from the side its vertex normals point to."""
+    a, b, c = xf.p(a), xf.p(b), xf.p(c)
+    na, nb, nc = xf.n(na), xf.n(nb), xf.n(nc)
+    g = _cross(_sub(b, a), _sub(c, a))
+    if _dot(g, (na[0] + nb[0] + nc[0], na[1] + nb[1] + nc[1], na[2] + nb[2] + nc[2])) < 0:
+        b, c, nb, nc = c, b, nc, nb
+    s.tri(a, b, c, mtl, na, nb, nc)
+
+
+def _grid(s, xf, pts, nrm, nu, nv, mtl):
+    """quads (i, j)-(i+1, j+1) of a (nu + 1) x (nv + 1) grid of points and normals"""
+    for i in range(nu):
+        for j in range(nv):
+            a, b, c, d = (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)
+            _tri_n(s, xf, pts[a], pts[b], pts[c], nrm[a], nrm[b], nrm[c], mtl)
+            _tri_n(s, xf, pts[a], pts[c], pts[d], nrm[a], nrm[c], nrm[d], mtl)
+
+
+def rounded_box(s, xf, c, h, r, mtl, nb=4, nf=(2, 2, 2)):
+    """A box of half extents h centred at c (local frame xf) with edges and corners
+    rounded to radius r: each face a grid of 2 nb + nf[axis] cells per axis, nb of
+    them (even steps in angle) on each rounded band; exact vertex normals."""
+    assert all(hk > 1.05 * r for hk in h), (h, r)
+    axes = []
+    for k in range(3):
+        e = h[k] - r
+        band = [r * math.tan(math.radians(45.0 * i / nb)) for i in range(1, nb + 1)]
+        axes.append([-e - t for t in reversed(band)]
+                    + [-e + 2 * e * j / nf[k] for j in range(nf[k] + 1)]
+                    + [e + t for t in band])
+
+    def point(g):
+        inner = tuple(max(-(h[k] - r), min(h[k] - r, g[k])) for k in range(3))
+        n = _norm(_sub(g, inner))
+        return (tuple(c[k] + inner[k] + r * n[k] for k in range(3)), n)
+    for k in range(3):            # faces normal to axis k
+        u, v = (k + 1) % 3, (k + 2) % 3
+        for sgn in (-1, 1):
+            pts, nrm = {}, {}
+            for i, gu in enumerate(axes[u]):
+                for j, gv in enumerate(axes[v]):
+                    g = [0, 0, 0]
+                    g[k], g[u], g[v] = sgn * h[k], gu, gv
+                    pts[i, j], nrm[i, j] = point(g)
+            _grid(s, xf, pts, nrm, len(axes[u]) - 1, len(axes[v]) - 1, mtl)
+
+
+def cylinder(s, xf, p0, p1, r0, mtl, n=24, r1=None, caps=True):
+    """A closed (truncated) cone from p0 (radius r0) to p1 (radius r1, default r0),
+    smooth sides, flat caps."""
+    r1 = r0 if r1 is None else r1
+    ax = _sub(p1, p0)
+    ln = math.sqrt(_dot(ax, ax))
+    w = _norm(ax)
+    u = _norm(_cross(w, (1, 0, 0) if abs(w[0]) < 0.9 else (0, 0, 1)))
+    v = _cross(w, u)
+    slope = (r0 - r1) / ln      # the side normal leans towards p1 if r narrows
+
+    def ring(p, r, a):
+        d = tuple(math.cos(a) * u[k] + math.sin(a) * v[k] for k in range(3))
+        nn = _norm(tuple(d[k] + slope * w[k] for k in range(3)))
+        return tuple(p[k] + r * d[k] for k in range(3)), nn
+    pts, nrm = {}, {}
+    for i in range(n + 1):
+        a = 2 * math.pi * (i % n) / n
+        pts[i, 0], nrm[i, 0] = ring(p0, r0, a)
+        pts[i, 1], nrm[i, 1] = ring(p1, r1, a)
+    _grid(s, xf, pts, nrm, n, 1, mtl)
+    if caps:
+        mw = (-w[0], -w[1], -w[2])
+        for i in range(n):
+            _tri_n(s, xf, p0, pts[i, 0], pts[i + 1, 0], mw, mw, mw, mtl)
+            _tri_n(s, xf, p1, pts[i, 1], pts[i + 1, 1], w, w, w, mtl)
+
+
+def torus(s, xf, c, big_r, small_r, mtl, nu=32, nv=12, arc=360.0):
+    """A torus about the local vertical axis through c (tube radius small_r), or the
+    part of it up to `arc` degrees around (open ends: for handles that meet a body)."""
+    full = arc >= 360.0
+    pts, nrm = {}, {}
+    for i in range(nu + 1):
+        a = math.radians(arc * ((i % nu) if full else i) / nu)
+        for j in range(nv + 1):
+            b = 2 * math.pi * (j % nv) / nv
+            nn = (math.cos(b) * math.cos(a), math.sin(b), -math.cos(b) * math.sin(a))
+            rr = big_r + small_r * math.cos(b)
+            pts[i, j] = (c[0] + rr * math.cos(a), c[1] + small_r * math.sin(b),
+                         c[2] - rr * math.sin(a))
+            nrm[i, j] = nn
+    _grid(s, xf, pts, nrm, nu, nv, mtl)
+
+
+def ball(s, xf, c, r, mtl, nu=16, nv=8):
+    """Scene.sphere at the point c of the local frame"""
+    s.sphere(xf.p(c), r, mtl, nu=nu, nv=nv)
+
+
+def office_chair(s, cx, cz, facing, seat_m, frame_m, caster_m):
+    """A swivel chair with arms on five castered legs, centred at (cx, cz); facing as
+    chair()'s (0: faces -z, back rest on the +z side). 8000 triangles."""
+    xf = _Xf.yaw(facing).then(_Xf.move(cx, 0, cz))
+    for k in range(5):                                    # star base and casters
+        a = 90.0 + 72.0 * k + 36.0
+        leg = _Xf.yaw(a).then(xf)
+        rounded_box(s, leg, (0.165, 0.078, 0), (0.135, 0.022, 0.024), 0.014, frame_m,
+                    nb=2, nf=(2, 1, 1))
+        ball(s, leg, (0.30, 0.03, 0), 0.03, caster_m)
+    cylinder(s, xf, (0, 0.05, 0), (0, 0.11, 0), 0.06, frame_m, n=32)          # hub
+    torus(s, xf, (0, 0.11, 0), 0.045, 0.012, frame_m, nu=24, nv=8)
+    cylinder(s, xf, (0, 0.11, 0), (0, 0.28, 0), 0.035, frame_m, n=24)         # sleeve
+    cylinder(s, xf, (0, 0.28, 0), (0, 0.44, 0), 0.024, frame_m, n=24)         # column
+    rounded_box(s, xf, (0, 0.44, 0), (0.2, 0.015, 0.19), 0.01, frame_m, nb=2,
+                nf=(2, 1, 2))                                                # seat pan
+    rounded_box(s, xf, (0, 0.495, 0), (0.25, 0.045, 0.24), 0.04, seat_m, nb=4,
+                nf=(3, 1, 3))                                                # cushion
+    # the back rest, tilted back by 8 degrees, on a spine from the seat pan
+    back = _Xf.pitch(8, (0, 0.5, 0.25)).then(xf)
+    rounded_box(s, back, (0, 0.86, 0.27), (0.23, 0.26, 0.035), 0.03, seat_m, nb=4,
+                nf=(2, 2, 1))
+    rounded_box(s, back, (0, 0.6, 0.285), (0.045, 0.16, 0.012), 0.01, frame_m, nb=2,
+                nf=(1, 2, 1))
+    rounded_box(s, xf, (0, 0.445, 0.22), (0.045, 0.012, 0.07), 0.01, frame_m, nb=2,
+                nf=(1, 1, 2))
+    for sx in (-1, 1):                                   # arms
+        cylinder(s, xf, (sx * 0.12, 0.44, 0.02), (sx * 0.285, 0.44, 0.02), 0.012, frame_m,
+                 n=16)
+        cylinder(s, xf, (sx * 0.285, 0.44, 0.02), (sx * 0.285, 0.665, 0.02), 0.014, frame_m,
+                 n=16)
+        rounded_box(s, xf, (sx * 0.285, 0.68, 0.0), (0.032, 0.016, 0.13), 0.014, seat_m,
+                    nb=2, nf=(1, 1, 3))
+
+
+def cup(s, x, z, y, handle_deg, mtl):
+    """A mug standing at (x, y, z): a body, a rounded rim and a handle (half a torus
+    in a vertical plane, its ends in the body), the handle turned by handle_deg."""
+    xf = _Xf.move(x, y, z)
+    cylinder(s, xf, (0, 0, 0), (0, 0.09, 0), 0.04, mtl, n=32)
+    torus(s, xf, (0, 0.09, 0), 0.036, 0.005, mtl, nu=32, nv=8)
+    # the torus' half ring (+x through -z to -x) turned upright: x -> y, -z -> x
+    up = _Xf(((0, 0, -1), (1, 0, 0), (0, -1, 0)))
+    hx = up.then(_Xf.move(0.038, 0.045, 0)).then(_Xf.yaw(handle_deg)).then(xf)
+    torus(s, hx, (0, 0, 0), 0.026, 0.007, mtl, nu=16, nv=8, arc=180.0)
+
+
+def conference_fg():
+    """Herzog et al. 2007, Table 7.1's "Conference" row (265,880 primitives, 86 %
+    diffuse, final gathering): a closed 10 x 6 x 3 m conference room, every
+    material Lambertian, lit only by six suspended luminaires 0.4 m below the
+    ceiling that emit upwards, so that the ceiling alone is lit directly and the
+    rest of the room by interreflection. Nearly all of its 261k triangles are
+    finely tessellated furniture (24 swivel chairs of 8000, mugs, fruit, plants):
+    many small curved objects and concave contacts, where a photon map's density
+    estimate is biased. Too large to commit: written only when named."""
+    s = Scene("conference_fg")
+    W, D, H, T = 10.0, 6.0, 3.0, 0.2
+    beige = s.material("wall_beige", kd=(0.76, 0.72, 0.64))
+    accent = s.material("wall_bluegrey", kd=(0.40, 0.48, 0.58))
+    floor = s.material("carpet", kd=(0.44, 0.42, 0.46))
+    ceil = s.material("ceiling", kd=(0.80, 0.80, 0.80))
+    wood = s.material("wood_table", kd=(0.50, 0.34, 0.22))
+    door_m = s.material("wood_door", kd=(0.55, 0.40, 0.25))
+    frame = s.material("frame_grey", kd=(0.36, 0.36, 0.38))
+    dark = s.material("caster_dark", kd=(0.20, 0.20, 0.21))
+    fabric = s.material("fabric_charcoal", kd=(0.28, 0.29, 0.33))
+    fabric2 = s.material("fabric_teal", kd=(0.20, 0.40, 0.42))
+    board = s.material("whiteboard", kd=(0.78, 0.78, 0.78))
+    white = s.material("ceramic_white", kd=(0.75, 0.74, 0.70))
+    paper = s.material("paper", kd=(0.78, 0.78, 0.76))
+    fruit = [s.material("fruit_%s" % n, kd=c) for n, c in (
+        ("orange", (0.75, 0.40, 0.20)), ("green", (0.40, 0.60, 0.20)),
+        ("red", (0.60, 0.20, 0.20)), ("yellow", (0.75, 0.65, 0.25)))]
+    leaf = s.material("leaves", kd=(0.20, 0.40, 0.22))
+    pot = s.material("terracotta", kd=(0.60, 0.38, 0.28))
+    housing = s.material("luminaire", kd=(0.70, 0.70, 0.70))
+    lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(30, 30, 30))
+    for m in s.mtls.values():   # Lambertian only, albedo 0.2-0.8
+        assert all(l.startswith(("Kd", "Ke")) for l in m), m
+        assert all(0.2 <= float(c) <= 0.8 for c in m[0].split()[1:]), m
+
+    s.group("floor")
+    s.box((-T, -T, -T), (W + T, 0, D + T), floor)
+    s.group("ceiling")
+    s.box((-T, H, -T), (W + T, H + T, D + T), ceil)
+    s.group("walls")
+    s.box((-T, -0.1, -T), (0, H + 0.1, D + T), beige)                      # west
+    s.box((W, -0.1, -T), (W + T, H + 0.1, D + T), beige, {"-x": accent})   # east
+    s.box((-T, -0.1, D), (W + T, H + 0.1, D + T), beige)                   # north
+    # south wall with a door recess: opening x in [4, 5], the door 0.12 m deep in it
+    dx0, dx1 = 4.0, 5.0
+    s.wall("x", -T / 2, -T / 2, W + T / 2, T, beige, doors=[(dx0, dx1)], y0=-0.1,
+           y1=H + 0.1)
+    s.group("door")
+    s.box((dx0 - 0.05, -0.05, -T), (dx1 + 0.05, H_DOOR + 0.05, -0.12), door_m)
+    dxf = _Xf.move(dx1 - 0.12, 1.0, -0.12)
+    cylinder(s, dxf, (0, 0, 0), (0, 0, 0.02), 0.03, frame, n=24)             # rose
+    cylinder(s, dxf, (0, 0, 0.01), (0, 0, 0.06), 0.009, frame, n=16)
+    cylinder(s, dxf, (0.005, 0, 0.055), (-0.12, 0, 0.055), 0.01, frame, n=16)  # lever
+
+    # six indirect luminaires hanging 0.4 m below the ceiling: a housing 2.2 x 0.2 m
+    # on two wires, its top an emitter whose front face points up (+y)
+    s.group("luminaires")
+    ly = H - 0.4
+    for cz in (1.9, 4.1):
+        for cx in (2.3, 5.0, 7.7):
+            xf = _Xf.move(cx, 0, cz)
+            rounded_box(s, xf, (0, ly - 0.03, 0), (1.1, 0.03, 0.1), 0.012, housing, nb=2,
+                        nf=(6, 1, 2))
+            for wx in (-0.9, 0.9):
+                cylinder(s, xf, (wx, ly, 0), (wx, H, 0), 0.003, frame, n=8)
+    s.group("lights")
+    for cz in (1.9, 4.1):
+        for cx in (2.3, 5.0, 7.7):
+            sx, sz, y = 2.16, 0.16, ly + 0.001
+            x0, x1, z0, z1 = cx - sx / 2, cx + sx / 2, cz - sz / 2, cz + sz / 2
+            s.quad(((x0, y, z0), (x1, y, z0), (x1, y, z1), (x0, y, z1)), (0, 1, 0), lamp)
+            for m, f in s.groups[-1][1][-2:]:   # the front (emitting) face looks up
+                a, b, c = (tuple(float(t) for t in s.verts[v - 1]) for v, _ in f)
+                assert m == lamp and _cross(_sub(b, a), _sub(c, a))[1] > 0
+            s.light_panels += 1
+            s.light_area += sx * sz
+
+    s.group("table")   # 7 x 1.5 m, top at 0.76 m, on four round legs with foot rings
+    tx0, tx1, tz0, tz1 = 1.5, 8.5, 2.25, 3.75
+    ty = 0.76
+    txf = _Xf.move((tx0 + tx1) / 2, 0, (tz0 + tz1) / 2)
+    rounded_box(s, txf, (0, ty - 0.025, 0), ((tx1 - tx0) / 2, 0.025, (tz1 - tz0) / 2), 0.02,
+                wood, nb=4, nf=(24, 1, 6))
+    for lx in (-3.05, 3.05):
+        for lz in (-0.45, 0.45):
+            cylinder(s, txf, (lx, 0, lz), (lx, ty - 0.05, lz), 0.04, frame, n=48)
+            torus(s, txf, (lx, 0.015, lz), 0.05, 0.015, frame, nu=32, nv=12)
+            torus(s, txf, (lx, ty - 0.065, lz), 0.05, 0.015, frame, nu=32, nv=12)
+        cylinder(s, txf, (lx, ty - 0.065, -0.45), (lx, ty - 0.065, 0.45), 0.025, frame, n=24)
+    cylinder(s, txf, (-3.05, 0.12, 0), (3.05, 0.12, 0), 0.03, frame, n=32)
+
+    # 24 swivel chairs: 9 along each long side of the table, one at each end, and
+    # four spare ones against the north wall
+    rng = random.Random(2007)
+    s.group("chairs")
+    seats = []
+    step = (tx1 - tx0) / 9
+    for k in range(9):
+        cx = tx0 + step * (k + 0.5)
+        for side in (-1, 1):   # -1: south side, facing +z (180)
+            back = rng.uniform(0.33, 0.55)
+            cz = (tz0 - back) if side < 0 else (tz1 + back)
+            fa = (180.0 if side < 0 else 0.0) + rng.uniform(-8, 8)
+            office_chair(s, cx + rng.uniform(-0.03, 0.03), cz, fa, fabric, frame, dark)
+            seats.append((cx, tz0 + 0.3 if side < 0 else tz1 - 0.3, side))
+    for side in (-1, 1):       # ends: facing +x at the west end, -x at the east end
+        back = rng.uniform(0.35, 0.5)
+        cx = (tx0 - back) if side < 0 else (tx1 + back)
+        office_chair(s, cx, 3.0 + rng.uniform(-0.05, 0.05), -side * 90 + rng.uniform(-6, 6),
+                     fabric, frame, dark)
+    for k in range(4):
+        office_chair(s, 1.3 + 0.78 * k, D - 0.5, rng.uniform(-5, 5), fabric2, frame, dark)
+
+    s.group("table_things")    # a notepad at each place and a mug right of most
+    for (cx, cz, side) in seats:
+        nx = cx + rng.uniform(-0.1, 0.1)
+        pad = _Xf.yaw(rng.uniform(-15, 15), (nx, 0, cz))
+        rounded_box(s, pad, (nx, ty + 0.006, cz), (0.105, 0.006, 0.148), 0.004, paper, nb=2,
+                    nf=(2, 1, 3))
+        if rng.random() < 0.8:
+            cup(s, cx + 0.29 + rng.uniform(-0.01, 0.03), cz + side * rng.uniform(0.0, 0.12),
+                ty, rng.uniform(0, 360), white)
+    for bx in (3.2, 5.0, 6.8):   # fruit bowls: a dish, a rim and fruit piled in it
+        bxf = _Xf.move(bx, ty, 3.0)
+        cylinder(s, bxf, (0, 0, 0), (0, 0.03, 0), 0.12, white, n=48, r1=0.17)
+        torus(s, bxf, (0, 0.03, 0), 0.165, 0.01, white, nu=48, nv=8)
+        for k in range(7):
+            a = 2 * math.pi * k / 7 + bx
+            ball(s, bxf, (0.095 * math.cos(a), 0.075, 0.095 * math.sin(a)), 0.045,
+                 fruit[rng.randrange(len(fruit))], nu=20, nv=10)
+        ball(s, bxf, (0, 0.1, 0), 0.05, fruit[rng.randrange(len(fruit))], nu=20, nv=10)
+        for k in range(3):
+            a = 2 * math.pi * k / 3 + 0.5
+            ball(s, bxf, (0.05 * math.cos(a), 0.148, 0.05 * math.sin(a)), 0.043,
+                 fruit[rng.randrange(len(fruit))], nu=20, nv=10)
+
+    s.group("whiteboard")      # on the west wall, with a pen tray
+    s.box((0, 0.9, 1.5), (0.03, 2.1, 4.5), board)
+    cylinder(s, _Xf(), (0.05, 0.88, 1.6), (0.05, 0.88, 4.4), 0.025, frame, n=24)
+
+    s.group("sideboard")       # against the north wall, with two vases
+    rounded_box(s, _Xf(), (7.2, 0.45, D - 0.26), (1.5, 0.45, 0.25), 0.02, wood, nb=3,
+                nf=(12, 6, 3))
+    for vx, vh in ((6.3, 0.35), (7.9, 0.25)):
+        vxf = _Xf.move(vx, 0.9, D - 0.26)
+        cylinder(s, vxf, (0, 0, 0), (0, vh, 0), 0.07, white, n=32, r1=0.05)
+        torus(s, vxf, (0, vh, 0), 0.05, 0.008, white, nu=32, nv=8)
+        ball(s, vxf, (0, 0.09, 0), 0.095, white, nu=32, nv=16)
+
+    s.group("plants")          # two potted plants: a pot, a stem and leafy balls
+    for px, pz in ((0.45, D - 0.45), (0.45, 0.45)):
+        pxf = _Xf.move(px, 0, pz)
+        cylinder(s, pxf, (0, 0, 0), (0, 0.42, 0), 0.17, pot, n=48, r1=0.22)
+        torus(s, pxf, (0, 0.42, 0), 0.21, 0.02, pot, nu=48, nv=12)
+        cylinder(s, pxf, (0, 0.4, 0), (0, 1.0, 0), 0.02, door_m, n=12)
+        for k in range(16):
+            a = rng.uniform(0, 2 * math.pi)
+            rr = rng.uniform(0.0, 0.22)
+            ball(s, pxf, (rr * math.cos(a), rng.uniform(0.65, 1.45), rr * math.sin(a)),
+                 rng.uniform(0.09, 0.15), leaf, nu=20, nv=10)
+
+    s.camera = ((9.6, 1.7, 5.1), (3.0, 0.45, 2.3), 62)
+    return s
+
+
 SCENES = {
     "office": office,
     "conference": conference,
@@ -1029,6 +1384,7 @@ SCENES = {
 # so not part of the default "all scenes" and not in scenes/generated in git.
 ON_DEMAND = {
     "building": building,
+    "conference_fg": conference_fg,
 }
 
 
