@@ -15,7 +15,9 @@
  *  3. each record's radius is eps R, R the harmonic mean distance within
  *     2 and 50 pixel widths (eq. 6.5, 6.6), shrunk to E / |grad E| where
  *     the irradiance changes faster (eq. 6.12; --cache-spacing geometric
- *     leaves it); records are splatted in image space onto the eye samples
+ *     leaves it), and by (passes)^(-1/6) as the kernels are (the report
+ *     renders one frame; without it the average kept the cache's
+ *     interpolation error: not consistent); records are splatted in image space onto the eye samples
  *     of their own segment within that radius with the weight of eq. 6.7
  *     (or Ward's), gathered pixel by pixel (deterministic);
  *  4. a region any of whose samples has fewer than N_c records halves its
@@ -56,6 +58,7 @@ typedef struct splat_cache {
     float *grad[3];   /* per sample: gradient of the irradiance's luminance (world) */
     float *rrad;      /* per record: radius eps R (world) */
     float *cw, *cwg, *cE[3], *cG, *cgm; /* per sample: weighted sums of the records' values */
+    float *cn;                           /* and of their splat counts (for --filter's boxes) */
     uint16_t *cnt;    /* per sample: records it gathered from */
     uint32_t *poff, *psam; /* pixel -> its samples */
     cdl_segments sg;
@@ -397,7 +400,9 @@ static float record_radius(const splat_state *s, const splat_cache *c, uint32_t 
         if (gl > 0.0f && E < gl * R)
             R = E / gl > rmin ? E / gl : rmin;
     }
-    return s->opt.splat.cache * R;
+    /* shrunk with the passes as the kernels are (eq. 4.9's M^(-1/6)):
+     * later passes take more records, and the average converges */
+    return s->opt.splat.cache * R * (float)pow(s->pp.m_scale, -1.0 / 6.0);
 }
 
 /* Eq. 6.7 (or Ward's weight) of record q (radius rr) at sample y. */
@@ -507,6 +512,7 @@ static int cache_splat(splat_state *s, splat_cache *c, uint32_t j0, uint32_t j1,
                             for (int ch = 0; ch < 3; ch++)
                                 c->cE[ch][yq] += w * s->E[ch][q];
                             c->cgm[yq] += w * lum_g;
+                            c->cn[yq] += w * s->nsum[q];
                             if (gy == SPLAT_LAMBERT) {
                                 c->cnt[yq] += c->cnt[yq] < UINT16_MAX;
                             } else if (glossy_maps && gq != SPLAT_LAMBERT) {
@@ -559,11 +565,12 @@ static int cache_init(splat_state *s, splat_cache *c, cdl_error *err)
     c->cw = calloc(n, sizeof(float));
     c->cwg = calloc(n, sizeof(float));
     c->cgm = calloc(n, sizeof(float));
+    c->cn = calloc(n, sizeof(float));
     c->cnt = calloc(n, sizeof *c->cnt);
     c->cG = calloc((s->nglossy ? s->nglossy : 1) * K3, sizeof(float));
     c->poff = calloc((size_t)np + 1, sizeof *c->poff);
     c->psam = malloc(sizeof *c->psam * n);
-    int ok = c->stop && c->lst_reg && c->reg_of && c->stride && c->nb && c->ne && c->is_rec && c->cw && c->cwg && c->cgm &&
+    int ok = c->stop && c->lst_reg && c->reg_of && c->stride && c->nb && c->ne && c->is_rec && c->cw && c->cwg && c->cgm && c->cn &&
              c->cnt && c->cG && c->poff && c->psam;
     for (int k = 0; k < 3; k++) {
         c->grad[k] = calloc(n, sizeof(float));
@@ -628,6 +635,7 @@ void splat_cache_free(splat_state *s)
     free(c->cw);
     free(c->cwg);
     free(c->cgm);
+    free(c->cn);
     free(c->cG);
     free(c->cnt);
     free(c->poff);
@@ -699,6 +707,9 @@ int splat_cache_solve(splat_state *s, cdl_error *err)
         for (int ch = 0; ch < 3; ch++)
             s->E[ch][q] = w > 0.0f ? c->cE[ch][q] / w : 0.0f;
         c->cgm[q] = w > 0.0f ? c->cgm[q] / w : 0.0f;
+        /* the splats a sample's value stands for: its records' (the
+         * filter sizes its boxes by them; only records were splatted) */
+        s->nsum[q] = w > 0.0f ? c->cn[q] / w : 0.0f;
         uint32_t g = s->gloss[q];
         if (g == SPLAT_LAMBERT)
             continue;

@@ -92,7 +92,11 @@ int splat_filter(splat_state *s, cdl_error *err)
     } else {
         for (uint32_t q = 0; q < s->neye; q++)
             count[s->eye[q].pixel] += s->nsum[q];
-        rc = cdl_segment_support(&sg, count, o->filter, o->filter_max, rad, err);
+        /* a box holding N splats grows as the kernels shrink with the
+         * passes (splats per sample ~ M^(-1/3)); N (pass)^(-2/3) makes it
+         * shrink as the kernels do instead, so the average converges */
+        float want = o->filter * (float)pow(s->pp.m_scale, -2.0 / 3.0);
+        rc = cdl_segment_support(&sg, count, want, o->filter_max, rad, err);
         if (!rc)
             rc = filter_image(s, &sg, rad, 3, 0, err);
         if (!rc && s->nglossy)

@@ -149,13 +149,14 @@ int splat_mask_prepare(splat_state *s)
      * rasterizing: the median footprint of a strided subset bounds them */
     splat_mask *m = s->mask;
     if (m->npw < s->tree.n) {
+        /* 16 lanes of padding: the leaf loops read whole batches */
         m->npw = 0;
         free(m->pw);
-        m->pw = malloc(sizeof *m->pw * s->tree.n);
+        m->pw = calloc((size_t)s->tree.n + 16, sizeof *m->pw);
         int ok = m->pw != NULL;
         for (int c = 0; c < 6; c++) {
             free(m->ax[c]);
-            ok &= (m->ax[c] = malloc(sizeof *m->ax[c] * s->tree.n)) != NULL;
+            ok &= (m->ax[c] = calloc((size_t)s->tree.n + 16, sizeof *m->ax[c])) != NULL;
         }
         if (!ok)
             return CDL_ERR_SYSTEM;
@@ -241,27 +242,37 @@ uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, u
     const int g = (int)fr[8];
     const uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
     const float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
+    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
+    const float h0 = r->h0, dh = r->dh, len = r->len, ics = 1.0f / fr[7], half = 0.5f * (float)g;
+    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
+    int cell[16];
+    float zz[16];
+    /* each lane's cell, 16 at a time (-1: outside the grid) */
+#pragma omp simd
+    for (int i = 0; i < 16; i++) {
+        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
+        float ex = px[i] - ox - z * dx, ey = py[i] - oy - z * dy, ez = pz[i] - oz - z * dz;
+        float ih = ics / (h0 + dh * fminf(z, len));
+        float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + half, v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + half;
+        int in = u >= 0.0f && v >= 0.0f && u < (float)g && v < (float)g;
+        cell[i] = in ? (int)v * g + (int)u : -1;
+        zz[i] = z;
+    }
     uint32_t keep = mask;
     for (; mask; mask &= mask - 1) {
         uint32_t i = (uint32_t)__builtin_ctz(mask), q = first + i;
-        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
-        float px = t->p[0][q], py = t->p[1][q], pz = t->p[2][q];
-        float ex = px - r->o.x - z * r->d.x, ey = py - r->o.y - z * r->d.y, ez = pz - r->o.z - z * r->d.z;
-        float ih = 1.0f / (fr[7] * (r->h0 + r->dh * fminf(z, r->len)));
-        int a = (int)floorf((ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g);
-        int b = (int)floorf((ex * V[0] + ey * V[1] + ez * V[2]) * ih + 0.5f * (float)g);
-        if (a < 0 || b < 0 || a >= g || b >= g)
+        if (cell[i] < 0)
             continue;
-        uint32_t o = occ[b * g + a];
+        uint32_t o = occ[cell[i]];
         float rho = m->pw[q];
-        if (o == UINT32_MAX || o == q || !(zmin[b * g + a] < z - rho))
+        if (o == UINT32_MAX || o == q || !(zmin[cell[i]] < zz[i] - rho))
             continue;
         /* hidden if the sample lies on the far side of the occluder's
          * tangent plane from the ray's origin; an occluder whose plane
          * holds the origin (the surface the ray leaves) hides nothing */
         float nx = t->nrm[0][o], ny = t->nrm[1][o], nz = t->nrm[2][o];
-        float so = (r->o.x - t->p[0][o]) * nx + (r->o.y - t->p[1][o]) * ny + (r->o.z - t->p[2][o]) * nz;
-        float sy = (px - t->p[0][o]) * nx + (py - t->p[1][o]) * ny + (pz - t->p[2][o]) * nz;
+        float so = (ox - t->p[0][o]) * nx + (oy - t->p[1][o]) * ny + (oz - t->p[2][o]) * nz;
+        float sy = (px[i] - t->p[0][o]) * nx + (py[i] - t->p[1][o]) * ny + (pz[i] - t->p[2][o]) * nz;
         float rho_o = m->pw[o];
         if (fabsf(so) > rho_o && (so > 0.0f ? sy < -rho : sy > rho))
             keep &= ~(1u << i);
