@@ -426,8 +426,7 @@ int cdl_render_setup(render_args *a, cdl_scene *scene, cdl_scene_settings *set, 
         opt->splat.gather = a->pm.gather;
     if (a->direct_given)
         opt->splat.direct_sample = !a->pm.direct_photons && a->pm.direct != CDL_DIRECT_NONE;
-    if (a->direct_given && a->pm.direct == CDL_DIRECT_NONE)
-        opt->splat.fractions[0] = 0.0f; /* no direct light: indirect light alone */
+    opt->splat.direct_none = a->direct_given && a->pm.direct == CDL_DIRECT_NONE;
     if (!rc && a->has_lookat)
         rc = cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
                              cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),

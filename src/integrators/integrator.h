@@ -62,6 +62,7 @@ typedef struct cdl_splat_options {
     float C, S, R;       /* bandwidth smoothness, sensitivity, clamping (§4.2) */
     int mode;            /* cdl_splat_mode: how the radiance maps hold incident light */
     int direct_sample;   /* direct light by light sampling instead of direct photons */
+    int direct_none;     /* no direct light at the camera's points (indirect light alone) */
     uint32_t eye_samples; /* eye samples per pixel and pass */
     int cull;            /* back-face-culling nodes in the eye-sample tree */
     int slabs;           /* the report's 1D slab traversal (Algorithm 1) instead of bounding spheres */

@@ -49,7 +49,10 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
         return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "splat does not interleave light paths");
     if (!scene->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "the scene has no lights: nothing to render");
-    float fsum = o->fractions[0] + o->fractions[1] + o->fractions[2];
+    /* --direct none without gathering: no direct photons, their share
+     * goes to the others (gather rays' hits always need them) */
+    float fd = o->direct_none && !o->gather ? 0.0f : o->fractions[0];
+    float fsum = fd + o->fractions[1] + o->fractions[2];
     if (!(fsum > 0.0f))
         return cdl_error_set(err, CDL_ERR_USAGE, "--fractions", 0, "at least one share must be positive");
     /* a scene without specular surfaces has no caustic rays: that share
@@ -57,14 +60,16 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     int specular = 0;
     for (uint32_t m = 0; m < scene->nmats; m++)
         specular |= cdl_mat_is_delta(scene->mats[m].type);
-    float share[CDL_PRAY_CATS] = {o->fractions[0], o->fractions[1], o->fractions[2]};
+    float share[CDL_PRAY_CATS] = {fd, o->fractions[1], o->fractions[2]};
     if (!specular) {
         share[CDL_PRAY_INDIRECT] += share[CDL_PRAY_CAUSTIC];
         share[CDL_PRAY_CAUSTIC] = 0.0f;
     }
     for (int c = 0; c < CDL_PRAY_CATS; c++) {
         float f = share[c] / fsum;
-        if (c == CDL_PRAY_DIRECT && o->direct_sample)
+        /* with light sampling the direct share stays unused (gather
+         * rays' hits need direct photons all the same) */
+        if (c == CDL_PRAY_DIRECT && o->direct_sample && !o->gather)
             f = 0.0f;
         s->pp.target[c] = (uint32_t)lrint((double)f * o->photons);
     }
@@ -180,7 +185,7 @@ static void eye_row(splat_state *s, int y, int y0, uint32_t pass, const cdl_dire
     const cdl_camera *cam = &s->opt.camera;
     const cdl_scene *sc = s->scene;
     uint32_t E = s->opt.splat.eye_samples, G = s->G;
-    int direct = s->opt.splat.direct_sample || s->opt.splat.gather;
+    int direct = (s->opt.splat.direct_sample || s->opt.splat.gather) && !s->opt.splat.direct_none;
     for (int x = 0; x < cam->width; x++) {
         uint32_t p = (uint32_t)y * (uint32_t)cam->width + (uint32_t)x;
         uint32_t pb = p - (uint32_t)y0 * (uint32_t)cam->width;
