@@ -106,7 +106,7 @@ static void rasterize(void *ctx, uint32_t first, uint32_t m, uint32_t mask, cons
         float so = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
         keep[i] = fabsf(so) > pw[i];
         /* in the kernel's plane: lateral offsets over the radius at z */
-        float ih = ics / (h0 + dh * fminf(z, len));
+        float ih = ics / (h0 + dh * (z < len ? z : len));
         float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g;
         float v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + 0.5f * (float)g;
         /* the patch's ellipse seen along d: its half extents in u and v */
@@ -114,11 +114,13 @@ static void rasterize(void *ctx, uint32_t first, uint32_t m, uint32_t mask, cons
         float t2 = ax[0][i] * V[0] + ax[1][i] * V[1] + ax[2][i] * V[2], b2 = ax[3][i] * V[0] + ax[4][i] * V[1] + ax[5][i] * V[2];
         float fu = sqrtf(t1 * t1 + b1 * b1) * ih, fv = sqrtf(t2 * t2 + b2 * b2) * ih;
         /* + 1 so truncation floors; clamped to the grid */
-        float u0 = u - fu + 1.0f, u1 = u + fu + 1.0f, v0 = v - fv + 1.0f, v1 = v + fv + 1.0f;
-        box[0][i] = (int)fminf(fmaxf(u0, 1.0f), (float)g) - 1;
-        box[1][i] = (int)fminf(fmaxf(u1, 0.0f), (float)g) - 1;
-        box[2][i] = (int)fminf(fmaxf(v0, 1.0f), (float)g) - 1;
-        box[3][i] = (int)fminf(fmaxf(v1, 0.0f), (float)g) - 1;
+        /* (comparisons, not fminf: the loop stays vectorized) */
+        float u0 = u - fu + 1.0f, u1 = u + fu + 1.0f, v0 = v - fv + 1.0f, v1 = v + fv + 1.0f, G = (float)g;
+        u0 = u0 > 1.0f ? u0 : 1.0f, u1 = u1 > 0.0f ? u1 : 0.0f, v0 = v0 > 1.0f ? v0 : 1.0f, v1 = v1 > 0.0f ? v1 : 0.0f;
+        box[0][i] = (int)(u0 < G ? u0 : G) - 1;
+        box[1][i] = (int)(u1 < G ? u1 : G) - 1;
+        box[2][i] = (int)(v0 < G ? v0 : G) - 1;
+        box[3][i] = (int)(v1 < G ? v1 : G) - 1;
     }
     for (; mask; mask &= mask - 1) {
         int i = __builtin_ctz(mask);
@@ -252,7 +254,7 @@ uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, u
     for (int i = 0; i < 16; i++) {
         float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
         float ex = px[i] - ox - z * dx, ey = py[i] - oy - z * dy, ez = pz[i] - oz - z * dz;
-        float ih = ics / (h0 + dh * fminf(z, len));
+        float ih = ics / (h0 + dh * (z < len ? z : len));
         float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + half, v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + half;
         int in = u >= 0.0f && v >= 0.0f && u < (float)g && v < (float)g;
         cell[i] = in ? (int)v * g + (int)u : -1;
