@@ -27,11 +27,13 @@ for sp in gradient geometric; do
       -o "$out/$sp-$w.exr" >"$out/$sp-$w.log"
   done
 done
-/usr/bin/python3 - "$out" "$ref" "$here/docs" <<'EOF'
+/usr/bin/python3 - "$out" "$ref" "$here/docs" "$here/bench" <<'EOF'
 import re, sys
 import numpy as np
 import OpenImageIO as oiio
 out, ref_path, docs = sys.argv[1:4]
+sys.path.insert(0, sys.argv[4])
+from boundary import boundary_mask
 def load(path, layer=""):
     b = oiio.ImageBuf(path)
     names = list(b.spec().channelnames)
@@ -41,19 +43,7 @@ def load(path, layer=""):
 lum = lambda x: x.mean(axis=2)
 ref = lum(load(ref_path))
 light = ref > 1.0  # the light seen: left out
-L = np.log(ref + 1e-2 * ref.mean())
-edge = np.zeros(L.shape, bool)
-for ax in (0, 1):
-    d = np.abs(np.diff(L, axis=ax)) > np.log(2.0)
-    if ax:
-        edge[:, :-1] |= d; edge[:, 1:] |= d
-    else:
-        edge[:-1, :] |= d; edge[1:, :] |= d
-mask = edge.copy()
-for _ in range(2):
-    m = mask.copy()
-    m[1:, :] |= mask[:-1, :]; m[:-1, :] |= mask[1:, :]; m[:, 1:] |= mask[:, :-1]; m[:, :-1] |= mask[:, 1:]
-    mask = m
+mask = boundary_mask(ref, eps=1e-2)
 valid = (ref > 0.02 * ref.mean()) & ~light
 err = lambda t: (t - ref) ** 2 / (ref ** 2 + 1e-3 * ref.mean() ** 2)
 print(f"shadow-boundary mask: {int((mask & valid).sum())} pixels")

@@ -53,29 +53,19 @@ done
   -o "$out/cache.exr" | tee "$out/cache.log"
 "$candela" render "${args[@]}" -i pm --direct none --gather 0 --knn "$k" --photons "$photons" --spp "$passes" \
   -o "$out/pm.exr" | tee "$out/pm.log"
-/usr/bin/python3 - "$out" "$png" "${SCENE:-sponza}" <<'EOF'
+/usr/bin/python3 - "$out" "$png" "${SCENE:-sponza}" "$here/bench" <<'EOF'
 import sys
 import numpy as np
 import OpenImageIO as oiio
 out, png, scene = sys.argv[1], sys.argv[2], sys.argv[3]
+sys.path.insert(0, sys.argv[4])
+from boundary import boundary_mask
 def load(n):
     return oiio.ImageBuf(f"{out}/{n}.exr").get_pixels(oiio.FLOAT)[:, :, :3].astype(np.float64)
 full, direct = load("path_d8"), load("path_d1")
 ref = np.clip(full - direct, 0, None)
 lum = lambda x: x.mean(axis=2)
-L = np.log(lum(full) + 1e-3 * lum(full).mean())
-edge = np.zeros(L.shape, bool)
-for dy, dx in ((0, 1), (1, 0)):
-    d = np.abs(np.diff(L, axis=1 if dx else 0)) > np.log(2.0)
-    if dx:
-        edge[:, :-1] |= d; edge[:, 1:] |= d
-    else:
-        edge[:-1, :] |= d; edge[1:, :] |= d
-mask = edge.copy()
-for _ in range(2):
-    m = mask.copy()
-    m[1:, :] |= mask[:-1, :]; m[:-1, :] |= mask[1:, :]; m[:, 1:] |= mask[:, :-1]; m[:, :-1] |= mask[:, 1:]
-    mask = m
+mask = boundary_mask(lum(full), eps=1e-3)
 r = lum(ref)
 floor = 0.05 * r.mean()
 # emitters the camera sees (the box's light): the methods keep them, the reference does not

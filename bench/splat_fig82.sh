@@ -35,28 +35,18 @@ run() { # name maxdepth splat-options...
 run direct 1 --photons 50000 --fractions 1,0,0
 run indirect $depth --photons 200000 --fractions 0,1,0 --direct none
 run global $depth --photons 250000 --fractions 0.2,0.8,0
-/usr/bin/python3 - "$out" "$here/docs/splat-fig82.png" <<'EOF'
+/usr/bin/python3 - "$out" "$here/docs/splat-fig82.png" "$here/bench" <<'EOF'
 import re, sys
 import numpy as np
 import OpenImageIO as oiio
 out, png = sys.argv[1], sys.argv[2]
+sys.path.insert(0, sys.argv[3])
+from boundary import boundary_mask
 load = lambda n: oiio.ImageBuf(f"{out}/{n}.exr").get_pixels(oiio.FLOAT)[:, :, :3].astype(np.float64)
 full, direct = load(f"path_d8"), load("path_d1")
 refs = {"direct": direct, "indirect": np.clip(full - direct, 0, None), "global": full}
 lum = lambda x: x.mean(axis=2)
-L = np.log(lum(direct) + 1e-2 * lum(direct).mean())
-edge = np.zeros(L.shape, bool)
-for ax in (0, 1):
-    d = np.abs(np.diff(L, axis=ax)) > np.log(2.0)
-    if ax:
-        edge[:, :-1] |= d; edge[:, 1:] |= d
-    else:
-        edge[:-1, :] |= d; edge[1:, :] |= d
-mask = edge.copy()
-for _ in range(2):
-    m = mask.copy()
-    m[1:, :] |= mask[:-1, :]; m[:-1, :] |= mask[1:, :]; m[:, 1:] |= mask[:, :-1]; m[:, :-1] |= mask[:, 1:]
-    mask = m
+mask = boundary_mask(lum(direct), eps=1e-2)
 seen_light = lum(direct) > 1.0  # the light itself: the reference and splat agree there, it swamps means
 print(f"shadow-boundary mask: {int((mask & ~seen_light).sum())} pixels")
 print("| light | mask | relMSE image | relMSE boundaries | mean ratio | time (s) |")

@@ -430,6 +430,26 @@ def office():
     return s
 
 
+def _conference_shell(s, W, D, H, T, floor, ceil, beige, accent, door_m):
+    """The conference rooms' floor, ceiling and walls, the south wall with a
+    door recess (opening x in [4, 5], the door 0.12 m deep in it); returns
+    the opening's x range."""
+    s.group("floor")
+    s.box((-T, -T, -T), (W + T, 0, D + T), floor)
+    s.group("ceiling")
+    s.box((-T, H, -T), (W + T, H + T, D + T), ceil)
+    s.group("walls")
+    s.box((-T, -0.1, -T), (0, H + 0.1, D + T), beige)               # west
+    s.box((W, -0.1, -T), (W + T, H + 0.1, D + T), beige, {"-x": accent})  # east
+    s.box((-T, -0.1, D), (W + T, H + 0.1, D + T), beige)            # north
+    dx0, dx1 = 4.0, 5.0
+    s.wall("x", -T / 2, -T / 2, W + T / 2, T, beige, doors=[(dx0, dx1)], y0=-0.1,
+           y1=H + 0.1)
+    s.group("door")
+    s.box((dx0 - 0.05, -0.05, -T), (dx1 + 0.05, H_DOOR + 0.05, -0.12), door_m)
+    return dx0, dx1
+
+
 def conference():
     s = Scene("conference")
     W, D, H, T = 10.0, 6.0, 3.0, 0.2
@@ -444,20 +464,7 @@ def conference():
     board = s.material("whiteboard", kd=(0.78, 0.78, 0.78), ks=(0.1, 0.1, 0.1), ns=300)
     lamp = s.material("light", kd=(0.8, 0.8, 0.8), ke=(20, 20, 20))
 
-    s.group("floor")
-    s.box((-T, -T, -T), (W + T, 0, D + T), floor)
-    s.group("ceiling")
-    s.box((-T, H, -T), (W + T, H + T, D + T), ceil)
-    s.group("walls")
-    s.box((-T, -0.1, -T), (0, H + 0.1, D + T), beige)               # west
-    s.box((W, -0.1, -T), (W + T, H + 0.1, D + T), beige, {"-x": accent})  # east
-    s.box((-T, -0.1, D), (W + T, H + 0.1, D + T), beige)            # north
-    # south wall with a door recess: opening x in [4, 5], the door 0.12 m deep in it
-    dx0, dx1 = 4.0, 5.0
-    s.wall("x", -T / 2, -T / 2, W + T / 2, T, beige, doors=[(dx0, dx1)], y0=-0.1,
-           y1=H + 0.1)
-    s.group("door")
-    s.box((dx0 - 0.05, -0.05, -T), (dx1 + 0.05, H_DOOR + 0.05, -0.12), door_m)
+    dx0, dx1 = _conference_shell(s, W, D, H, T, floor, ceil, beige, accent, door_m)
     s.box((dx1 - 0.15, 0.98, -0.12), (dx1 - 0.05, 1.02, -0.07), metal)   # handle
 
     s.group("lights")
@@ -1239,20 +1246,7 @@ def conference_fg():
         assert all(l.startswith(("Kd", "Ke")) for l in m), m
         assert all(0.2 <= float(c) <= 0.8 for c in m[0].split()[1:]), m
 
-    s.group("floor")
-    s.box((-T, -T, -T), (W + T, 0, D + T), floor)
-    s.group("ceiling")
-    s.box((-T, H, -T), (W + T, H + T, D + T), ceil)
-    s.group("walls")
-    s.box((-T, -0.1, -T), (0, H + 0.1, D + T), beige)                      # west
-    s.box((W, -0.1, -T), (W + T, H + 0.1, D + T), beige, {"-x": accent})   # east
-    s.box((-T, -0.1, D), (W + T, H + 0.1, D + T), beige)                   # north
-    # south wall with a door recess: opening x in [4, 5], the door 0.12 m deep in it
-    dx0, dx1 = 4.0, 5.0
-    s.wall("x", -T / 2, -T / 2, W + T / 2, T, beige, doors=[(dx0, dx1)], y0=-0.1,
-           y1=H + 0.1)
-    s.group("door")
-    s.box((dx0 - 0.05, -0.05, -T), (dx1 + 0.05, H_DOOR + 0.05, -0.12), door_m)
+    dx0, dx1 = _conference_shell(s, W, D, H, T, floor, ceil, beige, accent, door_m)
     dxf = _Xf.move(dx1 - 0.12, 1.0, -0.12)
     cylinder(s, dxf, (0, 0, 0), (0, 0, 0.02), 0.03, frame, n=24)             # rose
     cylinder(s, dxf, (0, 0, 0.01), (0, 0, 0.06), 0.009, frame, n=16)
