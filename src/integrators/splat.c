@@ -482,8 +482,9 @@ static void splat_report(const void *self)
            s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
     splat_cache_report(s);
     if (s->mask)
-        printf("splat: visibility mask: %.1f eye samples rasterized and %.1f tested per photon ray, %.1f %% of the "
-               "feasible splats masked\n",
+        printf("splat: visibility mask: %.1f %% of the photon rays met more than one plane and got a mask; %.1f eye "
+               "samples rasterized and %.1f tested per photon ray, %.1f %% of the feasible splats masked\n",
+               t->rays_stored ? 100.0 * (double)t->mask_rays / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
                t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);

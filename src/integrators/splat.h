@@ -30,7 +30,7 @@ typedef struct splat_eye {
 typedef struct splat_stats {
     double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_total;
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
-    uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized;
+    uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized, mask_rays;
     size_t peak_bytes;
 } splat_stats;
 

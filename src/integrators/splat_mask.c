@@ -14,7 +14,8 @@
  * (seen from the ray's origin) by more than its own footprint, so a
  * surface never shadows its own neighbours. Only occluders the camera sees
  * count (they must be eye samples), as the report says; the surface the
- * ray leaves is no occluder. Masks are built a batch of rays at a time,
+ * ray leaves is no occluder, and a frustum holding one plane's samples
+ * only needs no mask. Masks are built a batch of rays at a time,
  * each ray on its own (deterministic), then the batch splats part by part
  * as without them. */
 #include <math.h>
@@ -79,6 +80,78 @@ typedef struct build_ctx {
     const float *pw, *const *ax;
     uint64_t n; /* samples rasterized */
 } build_ctx;
+
+/* The frustum's samples of one ray, kept a leaf batch at a time until it
+ * is known whether they lie on more than one plane (per thread). */
+typedef struct held {
+    uint32_t first, mask;
+    float zz[16];
+} held;
+
+typedef struct hold_ctx {
+    const splat_state *s;
+    const cdl_photon_ray *r;
+    held *b;
+    uint32_t n, cap;
+    int oom;
+} hold_ctx;
+
+static void hold(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *zz)
+{
+    (void)m, (void)w;
+    hold_ctx *h = ctx;
+    if (h->oom)
+        return;
+    if (h->n == h->cap) {
+        uint32_t cap = h->cap ? 2 * h->cap : 64;
+        held *b = realloc(h->b, sizeof *b * cap);
+        if (!b) {
+            h->oom = 1;
+            return;
+        }
+        h->b = b;
+        h->cap = cap;
+    }
+    held *e = &h->b[h->n++];
+    e->first = first;
+    e->mask = mask;
+    memcpy(e->zz, zz, sizeof e->zz);
+}
+
+/* Whether the held samples that can hide anything (not on the surface the
+ * ray leaves) lie on one plane: within a quarter of the smallest footprint
+ * of the first one's plane, normals within 0.1 degree. No sample of a
+ * plane hides another (the filter's test needs one behind another's
+ * tangent plane by its footprint), so such a ray needs no mask. */
+static int one_plane(const hold_ctx *h)
+{
+    const cdl_skd *t = &h->s->tree;
+    const float *pw = h->s->mask->pw;
+    const cdl_vec3 o = h->r->o;
+    int have = 0, flat = 1;
+    float p0[3] = {0, 0, 0}, n0[3] = {0, 0, 0}, dmax = 0.0f, pmin = INFINITY;
+    for (uint32_t k = 0; k < h->n && flat; k++)
+        for (uint32_t mask = h->b[k].mask; mask; mask &= mask - 1) {
+            uint32_t q = h->b[k].first + (uint32_t)__builtin_ctz(mask);
+            float p[3] = {t->p[0][q], t->p[1][q], t->p[2][q]}, n[3] = {t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]};
+            float so = (p[0] - o.x) * n[0] + (p[1] - o.y) * n[1] + (p[2] - o.z) * n[2];
+            if (!(fabsf(so) > pw[q]))
+                continue; /* as rasterize: the origin's surface */
+            if (!have) {
+                memcpy(p0, p, sizeof p0);
+                memcpy(n0, n, sizeof n0);
+                have = 1;
+            }
+            float d = fabsf((p[0] - p0[0]) * n0[0] + (p[1] - p0[1]) * n0[1] + (p[2] - p0[2]) * n0[2]);
+            dmax = d > dmax ? d : dmax;
+            pmin = pw[q] < pmin ? pw[q] : pmin;
+            if (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2] < 0.9999985f || dmax > 0.25f * pmin) {
+                flat = 0;
+                break;
+            }
+        }
+    return flat;
+}
 
 static void rasterize(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *zz)
 {
@@ -198,8 +271,11 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
     splat_mask *m = s->mask;
     m->first = first;
     m->n = n;
-    uint64_t tested = 0, rasterized = 0;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : tested, rasterized)
+    uint64_t tested = 0, rasterized = 0, masks = 0;
+#pragma omp parallel reduction(+ : tested, rasterized, masks)
+    {
+    hold_ctx h = {s, NULL, NULL, 0, 0, 0};
+#pragma omp for schedule(dynamic, 64)
     for (uint32_t k = 0; k < n; k++) {
         const cdl_photon_ray *r = &s->rays.r[first + k];
         float *fr = m->frame + (size_t)k * 9;
@@ -214,23 +290,39 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
         fr[6] = 0.0f;
         fr[7] = 2.0f / (float)g; /* over the kernel's unit disc */
         fr[8] = (float)g;
+        fr[8] = 0.0f; /* no mask unless the frustum holds more than one plane */
+        if (!(hmax > 0.0f))
+            continue;
+        cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+        cdl_skd_count cnt = {0, 0};
+        h.r = r;
+        h.n = 0;
+        h.oom = 0;
+        cdl_skd_splat_visit(&s->tree, UINT32_MAX, &sr, CDL_SKD_ANY, hold, &h, &cnt);
+        tested += cnt.tested;
+        if (!h.oom && one_plane(&h))
+            continue;
+        fr[8] = (float)g;
+        masks++;
         uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
         float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
         for (int c = 0; c < g * g; c++) {
             occ[c] = UINT32_MAX;
             zmin[c] = INFINITY;
         }
-        if (!(hmax > 0.0f))
-            continue;
         build_ctx x = {s, r, fr, occ, zmin, m->pw, (const float *const *)m->ax, 0};
-        cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
-        cdl_skd_count cnt = {0, 0};
-        cdl_skd_splat_visit(&s->tree, UINT32_MAX, &sr, CDL_SKD_ANY, rasterize, &x, &cnt);
-        tested += cnt.tested;
+        if (h.oom) /* no memory to hold them: traverse again */
+            cdl_skd_splat_visit(&s->tree, UINT32_MAX, &sr, CDL_SKD_ANY, rasterize, &x, &cnt);
+        else
+            for (uint32_t b = 0; b < h.n; b++)
+                rasterize(&x, h.b[b].first, 16, h.b[b].mask, NULL, h.b[b].zz);
         rasterized += x.n;
+    }
+    free(h.b);
     }
     s->st.mask_tested += tested;
     s->st.rasterized += rasterized;
+    s->st.mask_rays += masks;
     return 0;
 }
 
@@ -242,6 +334,8 @@ uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, u
     uint32_t k = ray - m->first;
     const float *fr = m->frame + (size_t)k * 9, *U = fr, *V = fr + 3;
     const int g = (int)fr[8];
+    if (!g)
+        return mask; /* one plane in the frustum: nothing hidden */
     const uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
     const float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
