@@ -2,7 +2,9 @@
 # Equal time for splat (Herzog et al. 2007) against the photon map, path and
 # bdpt, with bench/compare, on McGuire's Cornell box (256x256, against the
 # pbrt reference) and Sponza (200x150, its light as a point light, against a
-# 4096-spp path render made here or by bench/splat_fig72.sh). splat runs with
+# 4096-spp path render made here as OUT/sponza_path_4096.exr: the same render
+# as bench/splat_fig72.sh's path_d8.exr, which can be copied there to save
+# the time). splat runs with
 # its defaults (direct maps, no cache) and with the report's cache (SH maps,
 # C 0.6, S 0.2, --cache 0.5) plus filtering; pm with its defaults (8 final
 # gather rays, precomputed irradiance).

@@ -43,7 +43,7 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     if (o->visibility_mask && o->cache > 0.0f)
         return cdl_error_set(err, CDL_ERR_USAGE, "--visibility-mask", 0,
                              "works without --cache (records are splatted without masks)");
-    if (o->visibility_mask && splat_mask_alloc(s, SPLAT_MASK_BATCH, err))
+    if (o->visibility_mask && splat_mask_alloc(s, err))
         return err->code;
     if (opt->interleave > 1)
         return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "splat does not interleave light paths");
@@ -325,7 +325,7 @@ static size_t bytes(const splat_state *s)
 {
     return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
            cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
-           splat_mask_bytes(s, SPLAT_MASK_BATCH) +
+           splat_mask_bytes(s) +
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
 }
 

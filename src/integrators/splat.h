@@ -108,14 +108,19 @@ void splat_cache_free(splat_state *s);
 void splat_cache_report(const splat_state *s);
 /* --aov records for sample q: 1 at a record, records gathered, |grad E|; 0 without a cache. */
 int splat_cache_aov(const splat_state *s, uint32_t q, float out[3]);
+/* A photon ray as the eye-sample tree's frustum queries take it. */
+static inline cdl_splat_ray splat_ray_of(const splat_state *s, const cdl_photon_ray *r)
+{
+    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+}
 /* The visibility mask (§8.1, splat_mask.c): the rays' occlusion buffers
  * built a batch at a time; filter drops from a batch's mask the samples
  * ray `ray`'s buffer hides (iz: one over their distance along it). */
 #define SPLAT_MASK_BATCH 8192u
 typedef struct splat_mask splat_mask;
-int splat_mask_alloc(splat_state *s, uint32_t batch, cdl_error *err);
+int splat_mask_alloc(splat_state *s, cdl_error *err);
 void splat_mask_free(splat_state *s);
-size_t splat_mask_bytes(const splat_state *s, uint32_t batch);
+size_t splat_mask_bytes(const splat_state *s);
 int splat_mask_prepare(splat_state *s);
 int splat_mask_build(splat_state *s, uint32_t first, uint32_t n);
 uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, uint32_t mask, const float *iz);

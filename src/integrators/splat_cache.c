@@ -17,8 +17,9 @@
  *     the irradiance changes faster (eq. 6.12; --cache-spacing geometric
  *     leaves it), and by (passes)^(-1/6) as the kernels are (the report
  *     renders one frame; without it the average kept the cache's
- *     interpolation error: not consistent); records are splatted in image space onto the eye samples
- *     of their own segment within that radius with the weight of eq. 6.7
+ *     interpolation error: not consistent); records are splatted in
+ *     image space onto the eye samples of their own segment within that
+ *     radius with the weight of eq. 6.7
  *     (or Ward's), gathered pixel by pixel (deterministic);
  *  4. a region any of whose samples has fewer than N_c records halves its
  *     stride: its every (stride/2)-th sample becomes a record; the new
@@ -84,11 +85,6 @@ static void push_ref(refs *b, uint64_t x)
         b->cap = cap;
     }
     b->v[b->n++] = x;
-}
-
-static cdl_splat_ray splat_ray_of(const splat_state *s, const cdl_photon_ray *r)
-{
-    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
 }
 
 static int add_record(splat_cache *c, uint32_t q)

@@ -302,7 +302,7 @@ int splat_maps_splat(splat_state *s)
             c.splats = c.masked = 0;
             for (uint32_t k = k0; k < k1 && !cdl_cancel; k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
-                cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+                cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;
                 c.t.ready = 0;
                 c.ray = k;

@@ -22,30 +22,33 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/grow.h"
 #include "integrators/splat.h"
 
 #define MASK_G 32
+#define FRAME 7 /* floats per ray: U, V, g (cells over the kernel's unit disc, each 2 / g wide) */
 
 struct splat_mask {
-    uint32_t first, n;  /* rays [first, first + n) */
+    uint32_t first;     /* the batch's first ray */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
     float *pw;          /* per eye sample (tree order) its footprint, contiguous for the leaf loops */
     float *ax[6];       /* and the semi-axes of the surface patch it stands for (see rasterize) */
     uint32_t npw;
     uint32_t *occ;      /* per ray: MASK_G^2 cells, the front sample or UINT32_MAX */
     float *zmin;        /* its distance along the ray */
-    float *frame;       /* per ray: U, V (perpendicular to d), the grid's half width, cell size, side */
+    float *frame;       /* per ray: U, V (perpendicular to d), the grid's side g (0: no mask) */
 };
 
-int splat_mask_alloc(splat_state *s, uint32_t batch, cdl_error *err)
+int splat_mask_alloc(splat_state *s, cdl_error *err)
 {
+    const size_t batch = SPLAT_MASK_BATCH;
     if (s->mask)
         return 0;
     splat_mask *m = s->mask = calloc(1, sizeof *m);
     if (m) {
-        m->occ = malloc(sizeof *m->occ * (size_t)batch * MASK_G * MASK_G);
-        m->zmin = malloc(sizeof *m->zmin * (size_t)batch * MASK_G * MASK_G);
-        m->frame = malloc(sizeof *m->frame * (size_t)batch * 9);
+        m->occ = malloc(sizeof *m->occ * batch * MASK_G * MASK_G);
+        m->zmin = malloc(sizeof *m->zmin * batch * MASK_G * MASK_G);
+        m->frame = malloc(sizeof *m->frame * batch * FRAME);
     }
     if (!m || !m->occ || !m->zmin || !m->frame)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the visibility masks");
@@ -66,9 +69,11 @@ void splat_mask_free(splat_state *s)
     s->mask = NULL;
 }
 
-size_t splat_mask_bytes(const splat_state *s, uint32_t batch)
+size_t splat_mask_bytes(const splat_state *s)
 {
-    return s->mask ? (size_t)batch * (MASK_G * MASK_G * 8 + 36) + 7 * sizeof(float) * s->mask->npw : 0;
+    return s->mask ? (size_t)SPLAT_MASK_BATCH * (MASK_G * MASK_G * 8 + FRAME * sizeof(float)) +
+                         7 * sizeof(float) * s->mask->npw
+                   : 0;
 }
 
 typedef struct build_ctx {
@@ -102,15 +107,9 @@ static void hold(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const flo
     hold_ctx *h = ctx;
     if (h->oom)
         return;
-    if (h->n == h->cap) {
-        uint32_t cap = h->cap ? 2 * h->cap : 64;
-        held *b = realloc(h->b, sizeof *b * cap);
-        if (!b) {
-            h->oom = 1;
-            return;
-        }
-        h->b = b;
-        h->cap = cap;
+    if (cdl_grow((void **)&h->b, &h->cap, h->n + 1, sizeof *h->b)) {
+        h->oom = 1;
+        return;
     }
     held *e = &h->b[h->n++];
     e->first = first;
@@ -158,9 +157,9 @@ static void rasterize(void *ctx, uint32_t first, uint32_t m, uint32_t mask, cons
     (void)m, (void)w;
     build_ctx *x = ctx;
     const cdl_skd *t = &x->s->tree;
-    const float *U = x->fr, *V = x->fr + 3, ics = 1.0f / x->fr[7];
+    const float *U = x->fr, *V = x->fr + 3, ics = 0.5f * x->fr[6];
     const float h0 = x->r->h0, dh = x->r->dh, len = x->r->len;
-    const int g = (int)x->fr[8];
+    const int g = (int)x->fr[6];
     const float ox = x->r->o.x, oy = x->r->o.y, oz = x->r->o.z, dx = x->r->d.x, dy = x->r->d.y, dz = x->r->d.z;
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
     const float *nx = t->nrm[0] + first, *ny = t->nrm[1] + first, *nz = t->nrm[2] + first, *pw = x->pw + first;
@@ -270,7 +269,6 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
 {
     splat_mask *m = s->mask;
     m->first = first;
-    m->n = n;
     uint64_t tested = 0, rasterized = 0, masks = 0;
 #pragma omp parallel reduction(+ : tested, rasterized, masks)
     {
@@ -278,7 +276,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
 #pragma omp for schedule(dynamic, 64)
     for (uint32_t k = 0; k < n; k++) {
         const cdl_photon_ray *r = &s->rays.r[first + k];
-        float *fr = m->frame + (size_t)k * 9;
+        float *fr = m->frame + (size_t)k * FRAME;
         cdl_frame f = cdl_frame_from(r->d);
         float hmax = r->h0 + r->dh * r->len;
         int g = MASK_G;
@@ -287,13 +285,10 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
         g = g < 1 ? 1 : g;
         fr[0] = f.t.x, fr[1] = f.t.y, fr[2] = f.t.z;
         fr[3] = f.b.x, fr[4] = f.b.y, fr[5] = f.b.z;
-        fr[6] = 0.0f;
-        fr[7] = 2.0f / (float)g; /* over the kernel's unit disc */
-        fr[8] = (float)g;
-        fr[8] = 0.0f; /* no mask unless the frustum holds more than one plane */
+        fr[6] = 0.0f; /* no mask unless the frustum holds more than one plane */
         if (!(hmax > 0.0f))
             continue;
-        cdl_splat_ray sr = {r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+        cdl_splat_ray sr = splat_ray_of(s, r);
         cdl_skd_count cnt = {0, 0};
         h.r = r;
         h.n = 0;
@@ -302,7 +297,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
         tested += cnt.tested;
         if (!h.oom && one_plane(&h))
             continue;
-        fr[8] = (float)g;
+        fr[6] = (float)g;
         masks++;
         uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
         float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
@@ -332,14 +327,14 @@ uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, u
     const cdl_skd *t = &s->tree;
     const cdl_photon_ray *r = &s->rays.r[ray];
     uint32_t k = ray - m->first;
-    const float *fr = m->frame + (size_t)k * 9, *U = fr, *V = fr + 3;
-    const int g = (int)fr[8];
+    const float *fr = m->frame + (size_t)k * FRAME, *U = fr, *V = fr + 3;
+    const int g = (int)fr[6];
     if (!g)
         return mask; /* one plane in the frustum: nothing hidden */
     const uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
     const float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float h0 = r->h0, dh = r->dh, len = r->len, ics = 1.0f / fr[7], half = 0.5f * (float)g;
+    const float h0 = r->h0, dh = r->dh, len = r->len, ics = 0.5f * (float)g, half = ics;
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
     int cell[16];
     float zz[16];

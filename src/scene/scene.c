@@ -1,27 +1,12 @@
 #include "scene/scene.h"
 
+#include "core/grow.h"
+
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Grows *buf (elem bytes each) to hold at least need elements. */
-static int grow(void **buf, uint32_t *cap, uint32_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 0;
-    uint64_t c = *cap ? *cap : 64;
-    while (c < need)
-        c *= 2;
-    if (c > UINT32_MAX / 2)
-        return -1;
-    void *p = realloc(*buf, (size_t)c * elem);
-    if (!p)
-        return -1;
-    *buf = p;
-    *cap = (uint32_t)c;
-    return 0;
-}
 
 static void embree_error(void *user, enum RTCError code, const char *str)
 {
@@ -79,9 +64,9 @@ int cdl_scene_add_vertices(cdl_scene *s, uint32_t n, const float *p, const float
     uint32_t need = s->nverts + n + 1; /* +1: Embree reads 16 bytes per vertex */
     if (need > s->cap_verts) {
         uint32_t cp = s->cap_verts, cn = cp, cu = cp;
-        if (grow((void **)&s->pos, &cp, need, 3 * sizeof(float)) ||
-            grow((void **)&s->nrm, &cn, need, 3 * sizeof(float)) ||
-            grow((void **)&s->uv, &cu, need, 2 * sizeof(float)))
+        if (cdl_grow((void **)&s->pos, &cp, need, 3 * sizeof(float)) ||
+            cdl_grow((void **)&s->nrm, &cn, need, 3 * sizeof(float)) ||
+            cdl_grow((void **)&s->uv, &cu, need, 2 * sizeof(float)))
             return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for %u vertices", need);
         s->cap_verts = cp;
     }
@@ -126,10 +111,10 @@ int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
         return 0;
     if (s->ntris == s->cap_tris) {
         uint32_t ci = s->cap_tris, cm = ci, ce = ci, cf = ci;
-        if (grow((void **)&s->idx, &ci, s->ntris + 1, 3 * sizeof(uint32_t)) ||
-            grow((void **)&s->tri_mat, &cm, s->ntris + 1, sizeof(uint32_t)) ||
-            grow((void **)&s->tri_emit, &ce, s->ntris + 1, sizeof(int32_t)) ||
-            grow((void **)&s->tri_flags, &cf, s->ntris + 1, sizeof(uint8_t)))
+        if (cdl_grow((void **)&s->idx, &ci, s->ntris + 1, 3 * sizeof(uint32_t)) ||
+            cdl_grow((void **)&s->tri_mat, &cm, s->ntris + 1, sizeof(uint32_t)) ||
+            cdl_grow((void **)&s->tri_emit, &ce, s->ntris + 1, sizeof(int32_t)) ||
+            cdl_grow((void **)&s->tri_flags, &cf, s->ntris + 1, sizeof(uint8_t)))
             return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for triangles");
         s->cap_tris = ci; /* all four grew to the same capacity */
     }
@@ -146,7 +131,7 @@ int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
 
 int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err)
 {
-    if (grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
+    if (cdl_grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for materials");
     s->mats[s->nmats] = *m;
     *id = s->nmats++;
@@ -155,7 +140,7 @@ int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cd
 
 int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *err)
 {
-    if (grow((void **)&s->texs, &s->cap_texs, s->ntexs + 1, sizeof(cdl_texture)))
+    if (cdl_grow((void **)&s->texs, &s->cap_texs, s->ntexs + 1, sizeof(cdl_texture)))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for textures");
     int rc = cdl_texture_load(&s->texs[s->ntexs], path, err);
     if (rc)
@@ -168,7 +153,7 @@ int cdl_scene_add_emitter(cdl_scene *s, cdl_vec3 L, int twosided, int32_t *id, c
 {
     if (!cdl_is_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "emitted radiance must be finite and >= 0");
-    if (grow((void **)&s->emitters, &s->cap_emitters, s->nemitters + 1, sizeof(cdl_emitter)))
+    if (cdl_grow((void **)&s->emitters, &s->cap_emitters, s->nemitters + 1, sizeof(cdl_emitter)))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
     s->emitters[s->nemitters] = (cdl_emitter){L, twosided};
     *id = (int32_t)s->nemitters++;
@@ -185,10 +170,10 @@ int cdl_scene_add_sphere(cdl_scene *s, cdl_vec3 c, float radius, uint32_t mat, i
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sphere material or emitter out of range");
     if (s->nspheres == s->cap_spheres) {
         uint32_t a = s->cap_spheres, b = a, c2 = a, d = a;
-        if (grow((void **)&s->sph, &a, s->nspheres + 1, 4 * sizeof(float)) ||
-            grow((void **)&s->sph_mat, &b, s->nspheres + 1, sizeof(uint32_t)) ||
-            grow((void **)&s->sph_emit, &c2, s->nspheres + 1, sizeof(int32_t)) ||
-            grow((void **)&s->sph_inward, &d, s->nspheres + 1, sizeof(uint8_t)))
+        if (cdl_grow((void **)&s->sph, &a, s->nspheres + 1, 4 * sizeof(float)) ||
+            cdl_grow((void **)&s->sph_mat, &b, s->nspheres + 1, sizeof(uint32_t)) ||
+            cdl_grow((void **)&s->sph_emit, &c2, s->nspheres + 1, sizeof(int32_t)) ||
+            cdl_grow((void **)&s->sph_inward, &d, s->nspheres + 1, sizeof(uint8_t)))
             return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for spheres");
         s->cap_spheres = a;
     }
@@ -206,7 +191,7 @@ int cdl_scene_add_sphere(cdl_scene *s, cdl_vec3 c, float radius, uint32_t mat, i
 
 static int add_light(cdl_scene *s, const cdl_light *l, cdl_error *err)
 {
-    if (grow((void **)&s->lights, &s->cap_lights, s->nlights + 1, sizeof *l))
+    if (cdl_grow((void **)&s->lights, &s->cap_lights, s->nlights + 1, sizeof *l))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for lights");
     s->lights[s->nlights++] = *l;
     return 0;

@@ -5,6 +5,7 @@
  * stop lists the radiance cache uses. The build is in splatkd.c. */
 #include "spatial/splatkd.h"
 
+#include "core/grow.h"
 #include "core/octahedral.h"
 #include "spatial/splatkd_node.h"
 
@@ -17,15 +18,9 @@
 
 static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
 {
-    if (out->n == out->cap) {
-        uint32_t cap = out->cap ? 2 * out->cap : 4096;
-        cdl_splat_hit *h = realloc(out->h, sizeof *h * cap);
-        if (!h) {
-            out->fail = 1;
-            return -1;
-        }
-        out->h = h;
-        out->cap = cap;
+    if (cdl_grow((void **)&out->h, &out->cap, out->n + 1, sizeof *out->h)) {
+        out->fail = 1;
+        return -1;
     }
     out->h[out->n++] = (cdl_splat_hit){s, w, iz};
     return 0;
