@@ -44,7 +44,8 @@ int main(int argc, char **argv)
     }
     if (nrays < 1000)
         nrays = 1000;
-    cdl_log_quiet = 1;
+    static const cdl_log_sink quiet = {NULL, NULL, 1};
+    cdl_log_push(&quiet);
     cdl_scene s;
     cdl_error err;
     int rc = cdl_scene_init(&s, argv[1], &err);

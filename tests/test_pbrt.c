@@ -221,9 +221,10 @@ static void test_include(void)
 
     /* an Include error names the including file and line */
     write_file("inc2.pbrt", "WorldBegin\n\nInclude \"nope.pbrt\"\n");
-    cdl_log_quiet = 1;
+    const cdl_log_sink quiet = {NULL, NULL, 1};
+    const cdl_log_sink *prev = cdl_log_push(&quiet);
     rc = load("inc2.pbrt", &s, &set, &err);
-    cdl_log_quiet = 0;
+    cdl_log_pop(prev);
     CHECK(rc != 0 && err.line == 3 && strstr(err.file, "inc2.pbrt"), "missing Include reported at %s:%d",
           err.file, err.line);
     cdl_scene_free(&s);

@@ -1,12 +1,9 @@
 /* candela command-line driver: parses options and calls the library. */
-#include <stdio.h>
 #include <string.h>
 
-#include "cli/commands.h"
-#include "core/error.h"
-#include "integrators/integrator.h"
+#include "cli.h"
 
-int cdl_report(const cdl_error *err)
+int cli_report(const cdl_error *err)
 {
     char buf[2048];
     cdl_error_format(err, buf, sizeof buf);
@@ -34,20 +31,20 @@ int main(int argc, char **argv)
         return 2;
     }
     if (!strcmp(argv[1], "render"))
-        return cdl_cmd_render(argc - 1, argv + 1);
+        return cli_render(argc - 1, argv + 1);
     if (!strcmp(argv[1], "photons"))
-        return cdl_cmd_photons(argc - 1, argv + 1);
+        return cli_photons(argc - 1, argv + 1);
     if (!strcmp(argv[1], "diff"))
-        return cdl_cmd_diff(argc - 1, argv + 1);
+        return cli_diff(argc - 1, argv + 1);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
         usage(stdout);
         return 0;
     }
     if (!strcmp(argv[1], "--version")) {
-        printf("candela 0.1\n");
+        printf("candela %s\n", cdl_version());
         return 0;
     }
-    cdl_error err;
-    cdl_error_set(&err, CDL_ERR_USAGE, argv[1], 0, "unknown command (try candela --help)");
-    return cdl_report(&err);
+    cdl_error err = {CDL_ERR_USAGE, 0, "", "unknown command (try candela --help)"};
+    snprintf(err.file, sizeof err.file, "%s", argv[1]);
+    return cli_report(&err);
 }

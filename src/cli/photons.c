@@ -1,78 +1,9 @@
 /* candela photons SCENE [render options] -o top.png: the stored photons
- * (and, with --importance, the importons) seen from above, as in Keller &
- * Wald's Figures 1, 2 and 4. Pass 0's maps are traced exactly as pm's
- * first pass traces them; walls (faces parallel to the up axis) are drawn
- * grey so that rooms without photons stay visible. */
-#include <math.h>
-#include <stdio.h>
+ * (and, with --importance, the importons in TOP.importons.png) seen from
+ * above, as in Keller & Wald's Figures 1, 2 and 4. */
 #include <string.h>
 
-#include "cli/commands.h"
-#include "cli/render_args.h"
-#include "core/log.h"
-#include "film/image.h"
-#include "integrators/pm.h"
-
-typedef struct view {
-    int up, u, v; /* axes */
-    float u0, v0, scale;
-    cdl_image img;
-} view;
-
-static void view_init(view *w, const cdl_scene *s, const cdl_camera *cam, int size, cdl_error *err, int *rc)
-{
-    float c[3] = {fabsf(cam->up.x), fabsf(cam->up.y), fabsf(cam->up.z)};
-    w->up = c[1] >= c[0] && c[1] >= c[2] ? 1 : (c[2] >= c[0] ? 2 : 0);
-    /* y up: x to the right, z down the image (a plan seen from above) */
-    w->u = w->up == 0 ? 1 : 0;
-    w->v = w->up == 2 ? 1 : 2;
-    float mn[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, mx[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
-    float eu = mx[w->u] - mn[w->u], ev = mx[w->v] - mn[w->v];
-    float e = eu > ev ? eu : ev;
-    w->scale = e > 0.0f ? (float)(size - 1) / e : 1.0f;
-    w->u0 = mn[w->u];
-    w->v0 = mn[w->v];
-    int iw = (int)(eu * w->scale) + 1, ih = (int)(ev * w->scale) + 1;
-    *rc = cdl_image_alloc(&w->img, iw < 1 ? 1 : iw, ih < 1 ? 1 : ih, err);
-}
-
-static void plot(view *w, const float *p, const float col[3])
-{
-    int x = (int)((p[w->u] - w->u0) * w->scale), y = (int)((p[w->v] - w->v0) * w->scale);
-    if (x < 0 || y < 0 || x >= w->img.width || y >= w->img.height)
-        return;
-    float *px = w->img.rgb + 3 * ((size_t)y * (size_t)w->img.width + (size_t)x);
-    for (int k = 0; k < 3; k++)
-        px[k] = fminf(1.0f, px[k] + col[k]);
-}
-
-static void walls(view *w, const cdl_scene *s)
-{
-    static const float grey[3] = {0.12f, 0.12f, 0.12f};
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        const float *n = &s->face_n[t].x;
-        if (fabsf(n[w->up]) > 0.1f)
-            continue;
-        for (int e = 0; e < 3; e++) {
-            const float *a = s->pos + 3 * (size_t)s->idx[3 * t + (uint32_t)e];
-            const float *b = s->pos + 3 * (size_t)s->idx[3 * t + (uint32_t)(e + 1) % 3];
-            float len = hypotf(b[w->u] - a[w->u], b[w->v] - a[w->v]) * w->scale;
-            int steps = (int)len + 1;
-            for (int i = 0; i <= steps; i++) {
-                float f = (float)i / (float)steps, q[3];
-                for (int k = 0; k < 3; k++)
-                    q[k] = a[k] + f * (b[k] - a[k]);
-                view *ww = w;
-                int x = (int)((q[ww->u] - ww->u0) * ww->scale), y = (int)((q[ww->v] - ww->v0) * ww->scale);
-                if (x >= 0 && y >= 0 && x < ww->img.width && y < ww->img.height) {
-                    float *px = ww->img.rgb + 3 * ((size_t)y * (size_t)ww->img.width + (size_t)x);
-                    for (int k = 0; k < 3; k++)
-                        px[k] = fmaxf(px[k], grey[k]);
-                }
-            }
-        }
-    }
-}
+#include "cli.h"
 
 static void sibling(const char *out, const char *tag, char *buf, size_t n)
 {
@@ -81,80 +12,47 @@ static void sibling(const char *out, const char *tag, char *buf, size_t n)
     snprintf(buf, n, "%.*s.%s%s", len, out, tag, dot ? dot : ".png");
 }
 
-int cdl_cmd_photons(int argc, char **argv)
+int cli_photons(int argc, char **argv)
 {
-    render_args a;
     cdl_error err;
-    int rc = cdl_render_parse(argc, argv, &a, &err);
-    if (rc < 0)
-        return 0;
-    if (rc)
-        return cdl_report(&err);
-    cdl_scene scene;
-    cdl_scene_settings set;
-    cdl_options opt;
-    char defout[1024];
-    cdl_importance imp;
-    int has_imp = 0;
-    cdl_photon_map g, c;
-    cdl_pmap_init(&g);
-    cdl_pmap_init(&c);
-    view pv = {0}, iv = {0};
-    rc = cdl_render_setup(&a, &scene, &set, &opt, defout, sizeof defout, &err);
-    if (!rc && a.out[0] == defout) { /* the default name of render is an EXR of the scene */
-        char *dot = strrchr(defout, '.');
-        snprintf(dot ? dot : defout + strlen(defout), 32, ".photons.png");
+    cli_args a;
+    cdl_settings *s = cdl_settings_create();
+    if (!s) {
+        fprintf(stderr, "candela: error: out of memory\n");
+        return 1;
     }
-    cdl_walk walk = {opt.maxdepth, opt.rr_depth};
-    float r = 0.0f;
-    cdl_photon_params pp = {0};
+    int rc = cli_parse(argc, argv, s, &a, &err);
+    if (rc) {
+        cdl_settings_release(s);
+        return rc < 0 ? 0 : cli_report(&err);
+    }
+    cdl_scene *scene = NULL;
+    cdl_image *ph = NULL, *imp = NULL;
+    char summary[512], out[1024], path[1100];
+    rc = cdl_scene_open(a.scene, s, &scene, &err);
     if (!rc)
-        rc = cdl_pm_max_radius(&scene, &opt.pm, &r, &err);
-    if (!rc)
-        rc = cdl_pm_photon_setup(&scene, &opt, &walk, r, &pp, &imp, &err);
-    has_imp = pp.imp != NULL;
-    cdl_photon_stats ps;
-    if (!rc)
-        rc = cdl_photons_trace(&scene, &walk, &pp, opt.sampler, opt.seed, 0, &g, &c, &ps, &err);
-    if (!rc)
-        view_init(&pv, &scene, &opt.camera, 800, &err, &rc);
-    if (!rc && has_imp)
-        view_init(&iv, &scene, &opt.camera, 800, &err, &rc);
+        rc = cdl_photon_plot(scene, s, 800, &ph, &imp, summary, sizeof summary, &err);
     if (!rc) {
-        /* dots bright enough to see single photons, saturating in dense regions */
-        static const float gcol[3] = {0.5f, 0.42f, 0.2f}, ccol[3] = {0.15f, 0.3f, 0.5f},
-                           icol[3] = {0.5f, 0.15f, 0.15f};
-        walls(&pv, &scene);
-        for (uint32_t i = 0; i < g.n; i++)
-            plot(&pv, g.ph[i].p, gcol);
-        for (uint32_t i = 0; i < c.n; i++)
-            plot(&pv, c.ph[i].p, ccol);
-        rc = cdl_image_write(a.out[0], &pv.img, NULL, 0, 0.0f, &err);
-        if (!rc && has_imp) {
-            walls(&iv, &scene);
-            for (uint32_t i = 0; i < imp.n; i++)
-                plot(&iv, imp.pts + 4 * (size_t)i, icol);
-            char path[1100];
-            sibling(a.out[0], "importons", path, sizeof path);
-            rc = cdl_image_write(path, &iv.img, NULL, 0, 0.0f, &err);
-            if (!rc)
-                printf("%s: %u importons from %llu paths, f = %.4g -> %s\n", a.scene, imp.n,
-                       (unsigned long long)imp.paths, imp.f, path);
+        if (a.nout) {
+            snprintf(out, sizeof out, "%s", a.out[0]);
+        } else { /* SCENE.photons.png in the current directory */
+            const char *base = strrchr(a.scene, '/');
+            base = base ? base + 1 : a.scene;
+            const char *dot = strrchr(base, '.');
+            snprintf(out, sizeof out, "%.*s.photons.png", dot ? (int)(dot - base) : (int)strlen(base), base);
         }
-        if (!rc)
-            printf("%s: %llu photon paths (%llu for the global map), %u global + %u caustic photons "
-                   "stored of %llu hits, %.2f MiB -> %s\n",
-                   a.scene, (unsigned long long)ps.paths, (unsigned long long)ps.paths_global, g.n, c.n,
-                   (unsigned long long)ps.candidates,
-                   (double)(cdl_pmap_bytes(&g) + cdl_pmap_bytes(&c)) / (1024.0 * 1024.0), a.out[0]);
+        rc = cdl_image_save(ph, out, 0.0f, &err);
     }
-    int status = rc ? cdl_report(&err) : 0;
-    cdl_image_free(&pv.img);
-    cdl_image_free(&iv.img);
-    cdl_pmap_free(&g);
-    cdl_pmap_free(&c);
-    if (has_imp)
-        cdl_importance_free(&imp);
-    cdl_scene_free(&scene);
+    if (!rc && imp) {
+        sibling(out, "importons", path, sizeof path);
+        rc = cdl_image_save(imp, path, 0.0f, &err);
+    }
+    if (!rc)
+        printf("%s: %s -> %s%s%s\n", a.scene, summary, out, imp ? ", " : "", imp ? path : "");
+    int status = rc ? cli_report(&err) : 0;
+    cdl_image_release(ph);
+    cdl_image_release(imp);
+    cdl_scene_release(scene);
+    cdl_settings_release(s);
     return status;
 }

@@ -287,6 +287,10 @@ static int read_pixels(exr_context_t ctx, const char *path, cdl_image *img,
         return cdl_error_set(err, CDL_ERR_INPUT, path, 0,
                              "bad OpenEXR data window %d,%d .. %d,%d",
                              dw.min.x, dw.min.y, dw.max.x, dw.max.y);
+    if ((uint64_t)w * (uint64_t)h > CDL_MAX_PIXELS)
+        return cdl_error_set(err, CDL_ERR_INPUT, path, 0,
+                             "OpenEXR data window %lldx%lld is larger than candela reads (2^28 pixels)",
+                             (long long)w, (long long)h);
     if (cdl_image_alloc(img, (int)w, (int)h, err))
         return cdl_error_set(err, CDL_ERR_SYSTEM, path, 0,
                              "out of memory for a %dx%d image", (int)w,

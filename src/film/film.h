@@ -4,6 +4,7 @@
 #ifndef CDL_FILM_H
 #define CDL_FILM_H
 
+#include <stdatomic.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -24,6 +25,7 @@ typedef struct cdl_film {
      * (an integrator that fills one adds to it once per pixel sample). */
     struct cdl_aov *aovs;
     int naovs;
+    atomic_int *cancel; /* the render's cancel flag (NULL: none); see cdl_cancelled */
 } cdl_film;
 
 #define CDL_MAX_AOVS 16

@@ -22,9 +22,9 @@ int cdl_image_alloc(cdl_image *img, int w, int h, cdl_error *err)
     if (w <= 0 || h <= 0)
         return cdl_error_set(err, CDL_ERR_USAGE, NULL, 0,
                              "bad image size %dx%d", w, h);
-    if ((size_t)w > SIZE_MAX / 3 / sizeof(float) / (size_t)h)
-        return cdl_error_set(err, CDL_ERR_SYSTEM, NULL, 0,
-                             "image size %dx%d is too large", w, h);
+    if ((uint64_t)w * (uint64_t)h > CDL_MAX_PIXELS)
+        return cdl_error_set(err, CDL_ERR_INPUT, NULL, 0,
+                             "image size %dx%d is larger than candela handles (2^28 pixels)", w, h);
     img->rgb = calloc((size_t)w * (size_t)h * 3, sizeof(float));
     if (!img->rgb)
         return cdl_error_set(err, CDL_ERR_SYSTEM, NULL, 0,

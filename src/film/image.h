@@ -17,7 +17,11 @@ typedef struct cdl_kv {
     const char *value;
 } cdl_kv; /* string metadata */
 
-/* Zero-filled image; w, h > 0. */
+/* The largest image read or made: 2^28 pixels (16384 x 16384, 3 GiB of
+ * floats), so that a hostile file header cannot ask for more. */
+#define CDL_MAX_PIXELS (1ull << 28)
+
+/* Zero-filled image; w, h > 0 and w h <= CDL_MAX_PIXELS. */
 int cdl_image_alloc(cdl_image *img, int w, int h, cdl_error *err);
 /* Frees the pixels and zeroes the struct; safe on a zeroed image. */
 void cdl_image_free(cdl_image *img);

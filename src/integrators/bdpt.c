@@ -241,10 +241,10 @@ static int bdpt_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
                              &film->rays);
     }
     cdl_render_tiles(self, film, pass, bdpt_tile);
-    if (st->opt.light_paths && !cdl_cancel)
+    if (st->opt.light_paths && !cdl_cancelled(film->cancel))
         light_trace_pool(st, film);
     int nlists = st->ntiles > 1024 ? st->ntiles : 1024;
-    if (cdl_cancel) {
+    if (cdl_cancelled(film->cancel)) {
         for (int i = 0; i < nlists; i++)
             st->tile_splats[i].n = 0; /* an interrupted pass's splats are incomplete */
         return 0;

@@ -348,6 +348,7 @@ static float cap_unit(const gkde_state *s)
 static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     gkde_state *s = self;
+    s->cancel = film->cancel;
     double t0 = cdl_time_now();
     int rc = trace_eyes(s, pass, &film->rays, err);
     double t1 = cdl_time_now();
@@ -362,7 +363,7 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
         rc = gkde_build_points(s, err);
     if (!rc)
         rc = check_memory(s, err);
-    if (rc || cdl_cancel)
+    if (rc || cdl_cancelled(s->cancel))
         return rc;
     if (!(s->r_cap > 0.0f)) { /* the first step fixes h and the cap */
         float u = cap_unit(s);
@@ -384,7 +385,7 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     rc = check_memory(s, err);
     if (rc)
         return rc;
-    if (cdl_cancel)
+    if (cdl_cancelled(s->cancel))
         return 0; /* an interrupted step adds nothing */
     /* the step's image: links per eye vertex, emitters the eye paths hit */
     const cdl_camera *cam = &s->opt.camera;
@@ -415,23 +416,32 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     return 0;
 }
 
-static void gkde_report(const void *self)
+static void gkde_report(const void *self, cdl_stats *out)
 {
     const gkde_state *s = self;
     const gkde_stats *t = &s->st;
-    if (cdl_log_quiet || !t->steps)
+    if (!t->steps)
         return;
     double pts = t->points > 0.0 ? t->points : 1.0, tt = t->t_total > 0.0 ? t->t_total : 1.0;
-    printf("gkde: h %.4g%s, %u light paths and %u eye path(s) per pixel per step; per eye vertex and "
+    cdl_stats_printf(out, "gkde: h %.4g%s, %u light paths and %u eye path(s) per pixel per step; per eye vertex and "
            "step %.1f candidate links, %.1f trial links, %.1f unoccluded (M = %u); stored paths %.1f MiB "
            "(peak)\n",
            (double)s->h, s->opt.gkde.bandwidth > 0.0f ? " (given)" : " (calibrated)", s->n_light, s->eye_paths,
            t->candidates / pts, t->trials / pts, t->unoccluded / pts, s->M, (double)t->peak_bytes / 1048576.0);
-    printf("gkde: time over %u steps %.2f s: eye paths %.0f %%, light paths %.0f %%, counting %.0f %%, "
+    cdl_stats_printf(out, "gkde: time over %u steps %.2f s: eye paths %.0f %%, light paths %.0f %%, counting %.0f %%, "
            "linking %.0f %%, shadow rays %.0f %%, scoring %.0f %% (CPU seconds of all threads "
            "for the last three)\n",
            t->steps, t->t_total, 100.0 * t->t_eye / tt, 100.0 * t->t_light / tt, 100.0 * t->t_count / tt,
            100.0 * t->t_link / tt, 100.0 * t->t_rays / tt, 100.0 * t->t_score / tt);
+    cdl_stats_add(out, "h", (double)s->h);
+    cdl_stats_add(out, "unoccluded_links", t->unoccluded / pts);
+    cdl_stats_add(out, "memory_mib", (double)t->peak_bytes / 1048576.0);
+    cdl_stats_add(out, "t_eye", t->t_eye);
+    cdl_stats_add(out, "t_light", t->t_light);
+    cdl_stats_add(out, "t_count", t->t_count);
+    cdl_stats_add(out, "t_link", t->t_link);
+    cdl_stats_add(out, "t_rays", t->t_rays);
+    cdl_stats_add(out, "t_score", t->t_score);
 }
 
 static void gkde_destroy(void *self)

@@ -70,6 +70,7 @@ typedef struct gkde_state {
     size_t rec_bytes;
     cdl_gkde_ctx g;
     gkde_stats st;
+    atomic_int *cancel; /* the film's, set by each pass */
 } gkde_state;
 
 /* The eye vertex (store index) of point q. */

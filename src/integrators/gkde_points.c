@@ -415,7 +415,7 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
         bundle *b = malloc(sizeof *b);
 #pragma omp for schedule(dynamic, 1)
         for (uint32_t g = 0; g < s->nseg; g++) {
-            if (!lc || !b || cdl_cancel)
+            if (!lc || !b || cdl_cancelled(s->cancel))
                 continue;
             const seg *sg = &s->segs[g];
             lc->s = s;

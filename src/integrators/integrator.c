@@ -3,7 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-volatile sig_atomic_t cdl_cancel = 0;
 
 extern const cdl_integrator_vtbl cdl_path_integrator;
 extern const cdl_integrator_vtbl cdl_bdpt_integrator;
@@ -101,7 +100,7 @@ void cdl_render_tiles(void *self, cdl_film *film, uint32_t pass, cdl_tile_fn fn)
     uint64_t rays = 0, bad = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, bad)
     for (int t = 0; t < ntiles; t++) {
-        if (cdl_cancel)
+        if (cdl_cancelled(film->cancel))
             continue;
         int x0 = (t % tx) * T, y0 = (t / tx) * T;
         int x1 = x0 + T < film->width ? x0 + T : film->width;

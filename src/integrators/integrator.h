@@ -4,10 +4,11 @@
 #ifndef CDL_INTEGRATOR_H
 #define CDL_INTEGRATOR_H
 
-#include <signal.h>
+#include <stdatomic.h>
 #include <stdint.h>
 
 #include "core/error.h"
+#include "core/stats.h"
 #include "core/sampler.h"
 #include "transport/mis.h"
 #include "film/film.h"
@@ -119,7 +120,7 @@ typedef struct cdl_integrator_vtbl {
     int (*prepare)(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err);
     int (*render_pass)(void *self, cdl_film *film, uint32_t pass, cdl_error *err);
     void (*destroy)(void *self);
-    void (*report)(const void *self); /* optional: statistics after rendering (stdout) */
+    void (*report)(const void *self, cdl_stats *out); /* optional: statistics after rendering */
     size_t self_size;
 } cdl_integrator_vtbl;
 
@@ -128,8 +129,12 @@ typedef struct cdl_integrator {
     void *self;
 } cdl_integrator;
 
-/* Set from a signal handler: passes stop at the next tile. */
-extern volatile sig_atomic_t cdl_cancel;
+/* A render's cancel flag (film->cancel, set by cdl_renderer_cancel from
+ * any thread or a signal handler): passes stop at the next tile. */
+static inline int cdl_cancelled(atomic_int *flag)
+{
+    return flag && atomic_load_explicit(flag, memory_order_relaxed);
+}
 
 const cdl_integrator_vtbl *cdl_integrator_find(const char *name);
 /* Names of all integrators, NULL-terminated. */

@@ -333,26 +333,33 @@ static int pm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *
     return 0;
 }
 
-static void pm_report(const void *self)
+static void pm_report(const void *self, cdl_stats *out)
 {
     const pm_state *st = self;
-    if (cdl_log_quiet)
-        return;
     double mib = 1.0 / (1024.0 * 1024.0);
-    printf("pm: per pass %llu photon paths traced (%llu for the global map), %u global + %u caustic "
+    cdl_stats_printf(out, "pm: per pass %llu photon paths traced (%llu for the global map), %u global + %u caustic "
            "photons stored of %llu surface hits; maps %.2f MiB (peak, %zu B per photon + kd-tree)\n",
            (unsigned long long)st->last.paths, (unsigned long long)st->last.paths_global, st->global.n,
            st->caustic.n, (unsigned long long)st->last.candidates, (double)st->peak_bytes * mib,
            sizeof(cdl_photon));
-    printf("pm: photon tracing %.2f s over %u passes", st->t_photons, st->passes);
+    cdl_stats_printf(out, "pm: photon tracing %.2f s over %u passes", st->t_photons, st->passes);
     if (st->has_imp)
-        printf("; %u importons from %llu paths (%.2f MiB, %.2f s), f = %.4g from %u test rays", st->imp.n,
+        cdl_stats_printf(out, "; %u importons from %llu paths (%.2f MiB, %.2f s), f = %.4g from %u test rays", st->imp.n,
                (unsigned long long)st->imp.paths, (double)cdl_importance_bytes(&st->imp) * mib,
                st->t_importons, st->imp.f, st->imp.tests);
     if (st->dcfg.kind != CDL_DIRECT_POWER && st->dcfg.kind != CDL_DIRECT_NONE && st->lcon_points)
-        printf("; |L_con| %.2f on average of %u lights", (double)st->lcon_sum / (double)st->lcon_points,
+        cdl_stats_printf(out, "; |L_con| %.2f on average of %u lights", (double)st->lcon_sum / (double)st->lcon_points,
                st->scene->nlights);
-    printf("\n");
+    cdl_stats_printf(out, "\n");
+    cdl_stats_add(out, "photon_paths", (double)st->last.paths);
+    cdl_stats_add(out, "global_photons", (double)st->global.n);
+    cdl_stats_add(out, "caustic_photons", (double)st->caustic.n);
+    cdl_stats_add(out, "map_mib", (double)st->peak_bytes * mib);
+    cdl_stats_add(out, "t_photons", st->t_photons);
+    if (st->has_imp) {
+        cdl_stats_add(out, "importons", (double)st->imp.n);
+        cdl_stats_add(out, "t_importons", st->t_importons);
+    }
 }
 
 static void pm_destroy(void *self)

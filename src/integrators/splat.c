@@ -385,7 +385,7 @@ static int band(splat_state *s, cdl_film *film, uint32_t pass, int y0, int y1, c
         rc = build(s, err);
     double t2 = cdl_time_now();
     s->st.t_build += t2 - t1;
-    if (rc || cdl_cancel)
+    if (rc || cdl_cancelled(s->cancel))
         return rc;
     if (s->opt.splat.cache > 0.0f) {
         rc = splat_cache_solve(s, err); /* counts its own T_solve and T_cache */
@@ -398,7 +398,7 @@ static int band(splat_state *s, cdl_film *film, uint32_t pass, int y0, int y1, c
             return cdl_error_set(err, rc, "splat", 0, "out of memory for the visibility masks");
     }
     double t3 = cdl_time_now();
-    if (cdl_cancel)
+    if (cdl_cancelled(s->cancel))
         return 0;
     rc = splat_filter(s, err);
     if (rc)
@@ -422,6 +422,7 @@ static int band(splat_state *s, cdl_film *film, uint32_t pass, int y0, int y1, c
 static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     splat_state *s = self;
+    s->cancel = film->cancel;
     double t0 = cdl_time_now();
     int a_bw = cdl_film_find_aov(film, "bandwidth");
     if (a_bw >= 0 && s->opt.splat.gather)
@@ -433,9 +434,9 @@ static int splat_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_erro
     const cdl_camera *cam = &s->opt.camera;
     size_t npix = (size_t)cam->width * (size_t)cam->height;
     memset(s->pix, 0, sizeof *s->pix * npix);
-    for (int y0 = 0; y0 < cam->height && !rc && !cdl_cancel; y0 += s->band_rows)
+    for (int y0 = 0; y0 < cam->height && !rc && !cdl_cancelled(s->cancel); y0 += s->band_rows)
         rc = band(s, film, pass, y0, y0 + s->band_rows < cam->height ? y0 + s->band_rows : cam->height, err);
-    if (rc || cdl_cancel)
+    if (rc || cdl_cancelled(s->cancel))
         return rc; /* an interrupted pass adds nothing */
     double t4 = cdl_time_now();
     uint64_t bad = 0;
@@ -460,14 +461,14 @@ static const char *mode_name(int m)
     return m == CDL_SPLAT_HISTOGRAM ? "histogram" : m == CDL_SPLAT_SH ? "sh" : "direct";
 }
 
-static void splat_report(const void *self)
+static void splat_report(const void *self, cdl_stats *out)
 {
     const splat_state *s = self;
     const splat_stats *t = &s->st;
-    if (cdl_log_quiet || !t->passes)
+    if (!t->passes)
         return;
     double P = (double)t->passes;
-    printf("splat: mode %s, %.0f photon rays per pass (budgets %u/%u/%u, paths %llu/%llu/%llu in the last), "
+    cdl_stats_printf(out, "splat: mode %s, %.0f photon rays per pass (budgets %u/%u/%u, paths %llu/%llu/%llu in the last), "
            "C %.2g S %.2g R %.2g, mean bandwidth scale mu_C %.4g; %.0f eye samples per pass, %.1f splats per "
            "photon ray, %.2f samples tested per splat, %.0f nodes visited per ray; memory %.1f MiB (peak)\n",
            mode_name(s->opt.splat.mode), (double)t->rays_stored / P, s->pp.target[0], s->pp.target[1],
@@ -476,20 +477,29 @@ static void splat_report(const void *self)
            (double)t->samples / P, t->rays_stored ? (double)t->splats / (double)t->rays_stored : 0.0,
            t->splats ? (double)t->tested / (double)t->splats : 0.0,
            t->rays_stored ? (double)t->nodes / (double)t->rays_stored : 0.0, (double)t->peak_bytes / 1048576.0);
-    printf("splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_cache %.2f, T_brdf %.2f "
+    cdl_stats_printf(out, "splat: time over %u passes %.2f s: T_ray %.2f, T_light %.2f, T_build %.2f, T_solve %.2f, T_cache %.2f, T_brdf %.2f "
            "(eye-sample tree: %u nodes, %u leaves, %u culling, %u empty, depth %u)\n",
            (unsigned)t->passes, t->t_total, t->t_ray, t->t_light, t->t_build, t->t_solve, t->t_cache, t->t_brdf,
            s->tree.nnodes, s->tree.leaves, s->tree.culls, s->tree.empties, s->tree.depth);
-    splat_cache_report(s);
+    cdl_stats_add(out, "rays_per_pass", (double)t->rays_stored / P);
+    cdl_stats_add(out, "splats_per_ray", t->rays_stored ? (double)t->splats / (double)t->rays_stored : 0.0);
+    cdl_stats_add(out, "memory_mib", (double)t->peak_bytes / 1048576.0);
+    cdl_stats_add(out, "t_ray", t->t_ray);
+    cdl_stats_add(out, "t_light", t->t_light);
+    cdl_stats_add(out, "t_build", t->t_build);
+    cdl_stats_add(out, "t_solve", t->t_solve);
+    cdl_stats_add(out, "t_cache", t->t_cache);
+    cdl_stats_add(out, "t_brdf", t->t_brdf);
+    splat_cache_report(s, out);
     if (s->mask)
-        printf("splat: visibility mask: %.1f %% of the photon rays met more than one plane and got a mask; %.1f eye "
+        cdl_stats_printf(out, "splat: visibility mask: %.1f %% of the photon rays met more than one plane and got a mask; %.1f eye "
                "samples rasterized and %.1f tested per photon ray, %.1f %% of the feasible splats masked\n",
                t->rays_stored ? 100.0 * (double)t->mask_rays / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
                t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);
     if (s->opt.splat.filter > 0.0f)
-        printf("splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
+        cdl_stats_printf(out, "splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
                (double)t->segments / P);
 }
 

@@ -73,6 +73,7 @@ typedef struct splat_state {
     cdl_sh_rot rot;
     cdl_bsdf_sh *tables; /* per material (SH mode) */
     splat_stats st;
+    atomic_int *cancel; /* the film's, set by each pass */
 } splat_state;
 
 /* What one ray adds per unit of kernel weight to a glossy sample's map,
@@ -105,7 +106,7 @@ void splat_maps_resolve(splat_state *s);
  * every sample. Replaces splat_maps_splat; times T_solve and T_cache. */
 int splat_cache_solve(splat_state *s, cdl_error *err);
 void splat_cache_free(splat_state *s);
-void splat_cache_report(const splat_state *s);
+void splat_cache_report(const splat_state *s, cdl_stats *out);
 /* --aov records for sample q: 1 at a record, records gathered, |grad E|; 0 without a cache. */
 int splat_cache_aov(const splat_state *s, uint32_t q, float out[3]);
 /* A photon ray as the eye-sample tree's frustum queries take it. */

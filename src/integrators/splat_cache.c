@@ -268,7 +268,7 @@ static int splat_round(splat_state *s, splat_cache *c, cdl_error *err)
     uint64_t splats = 0, tested = 0;
 #pragma omp parallel for schedule(dynamic, 4) reduction(+ : splats, tested)
     for (uint32_t l = 0; l < c->nlst; l++) {
-        if (rc || v.stride[l] == 0 || cdl_cancel)
+        if (rc || v.stride[l] == 0 || cdl_cancelled(s->cancel))
             continue;
         for (size_t i = c->roff[l]; i < c->roff[l + 1]; i++) {
             splat_terms t;
@@ -330,7 +330,7 @@ static int first_round(splat_state *s, splat_cache *c, cdl_error *err)
         x.c = c;
         x.v = &v;
         x.out = &bufs[part];
-        for (uint32_t k = 0; k < s->rays.n && !cdl_cancel && !bufs[part].fail; k++) {
+        for (uint32_t k = 0; k < s->rays.n && !cdl_cancelled(s->cancel) && !bufs[part].fail; k++) {
             x.t.r = &s->rays.r[k];
             x.t.ready = 0;
             x.sr = splat_ray_of(s, x.t.r);
@@ -657,7 +657,7 @@ int splat_cache_solve(splat_state *s, cdl_error *err)
         rc = first_round(s, c, err);
     double t_solve = cdl_time_now() - t0, t_cache = 0.0;
     uint32_t j0 = 0, rounds = 0;
-    while (!rc && !cdl_cancel) {
+    while (!rc && !cdl_cancelled(s->cancel)) {
         double t1 = cdl_time_now();
         uint32_t j1 = c->nrec;
         rc = cache_splat(s, c, j0, j1, err);
@@ -739,15 +739,16 @@ int splat_cache_aov(const splat_state *s, uint32_t q, float out[3])
     return 1;
 }
 
-void splat_cache_report(const splat_state *s)
+void splat_cache_report(const splat_state *s, cdl_stats *out)
 {
     const splat_stats *t = &s->st;
     if (!s->cache || !t->passes)
         return;
     double P = (double)t->passes;
-    printf("splat: cache: %.0f records per pass (%.2f %% of the eye samples) in %.1f rounds, %u regions, %.1f ray "
+    cdl_stats_printf(out, "splat: cache: %.0f records per pass (%.2f %% of the eye samples) in %.1f rounds, %u regions, %.1f ray "
            "references per photon ray; T_cache %.2f s\n",
            (double)t->records / P, t->samples ? 100.0 * (double)t->records / (double)t->samples : 0.0,
            (double)t->cache_passes / P, s->cache->nreg,
            t->rays_stored ? (double)t->ray_refs / (double)t->rays_stored : 0.0, t->t_cache);
+    cdl_stats_add(out, "records_per_pass", (double)t->records / P);
 }

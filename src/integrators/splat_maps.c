@@ -290,7 +290,7 @@ int splat_maps_splat(splat_state *s)
     uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
-    for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancel; k0 += batch) {
+    for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
         uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
         if (s->mask)
             splat_mask_build(s, k0, k1 - k0);
@@ -300,7 +300,7 @@ int splat_maps_splat(splat_state *s)
             ray_ctx c;
             c.s = s;
             c.splats = c.masked = 0;
-            for (uint32_t k = k0; k < k1 && !cdl_cancel; k++) {
+            for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
                 cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;

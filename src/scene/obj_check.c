@@ -237,6 +237,7 @@ typedef struct obj_ctx {
     const char *path;
     cdl_error *err;
     long nv, nvt, nvn, nfaces;
+    int last_count; /* numbers on the last line obj_numbers read */
     mtl_names names;
     int nmtllib;
     /* first usemtl of each name is checked once all MTLs are read */
@@ -260,6 +261,7 @@ static int obj_numbers(obj_ctx *c, line_cursor *lc, const char *key, int line, i
                                  "%s: coordinate %s is not finite or beyond %g", key, w, (double)limit);
         n++;
     }
+    c->last_count = n;
     if (n < min || n > max)
         return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, line, "%s expects %d to %d numbers, got %d",
                              key, min, max, n);
@@ -325,7 +327,13 @@ static int obj_line(void *vc, char *line, int lineno)
         return 0;
     if (!strcmp(key, "v")) {
         c->nv++;
-        return obj_numbers(c, &lc, key, lineno, 3, 7, CDL_MAX_COORD);
+        int n = obj_numbers(c, &lc, key, lineno, 3, 6, CDL_MAX_COORD);
+        /* Assimp reads x y z, x y z w or x y z r g b, and drops any other
+         * count's vertex, which shifts every later index */
+        if (!n && c->last_count == 5)
+            return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, lineno,
+                                 "v expects 3 (x y z), 4 (x y z w) or 6 (x y z r g b) numbers, got 5");
+        return n;
     }
     if (!strcmp(key, "vt")) {
         c->nvt++;

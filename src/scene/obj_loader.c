@@ -129,8 +129,11 @@ int cdl_load_obj(cdl_scene *s, const char *path, cdl_error *err)
     const struct aiScene *as =
         aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
                                aiProcess_SortByPType);
-    if (!as || !as->mRootNode)
-        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "import failed: %s", aiGetErrorString());
+    if (!as || !as->mRootNode) {
+        rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0, "import failed: %s", aiGetErrorString());
+        aiReleaseImport(as);
+        return rc;
+    }
 
     tex_cache tc = {NULL, NULL, 0};
     uint32_t mat_base = s->nmats;

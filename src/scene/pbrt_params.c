@@ -325,7 +325,7 @@ int cdl_pbrt_get_point3(cdl_pbrt_params *ps, const char *name, const double def[
 
 int cdl_pbrt_param_spectrum(cdl_pbrt_params *ps, cdl_pbrt_param *p, cdl_vec3 *out, cdl_error *err)
 {
-    const double *v = ps->num + p->off;
+    const double *v = ps->num ? ps->num + p->off : NULL; /* NULL + 0 is undefined */
     switch (p->type) {
     case CDL_PT_RGB:
         if (p->n != 3)

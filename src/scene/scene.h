@@ -26,6 +26,19 @@ typedef struct cdl_emitter {
     int twosided; /* triangles: both faces emit; otherwise the CCW front face */
 } cdl_emitter;
 
+/* What a scene file says about rendering; the command line overrides it. */
+typedef struct cdl_scene_settings {
+    int has_camera;                 /* eye/right/up/fwd/fov are set */
+    cdl_vec3 eye, right, up, fwd;   /* world images of camera origin and axes (pbrt) */
+    float fov;                      /* degrees, on the shorter image axis */
+    int width, height;              /* 0 = not given */
+    int spp;                        /* 0 = not given */
+    int maxdepth;                   /* -1 = not given */
+    char integrator[32];            /* candela integrator name, "" = not given */
+    char filename[1024];            /* the file's output image name, "" = not given */
+} cdl_scene_settings;
+
+/* Also the public API's scene handle (candela.h). */
 typedef struct cdl_scene {
     RTCDevice device;
     RTCScene rtc;
@@ -64,6 +77,7 @@ typedef struct cdl_scene {
     cdl_vec3 bmin, bmax; /* bounds of the geometry (after commit) */
     float eps;           /* ray offset scale (after commit) */
     char path[1024];     /* file the scene came from, for messages */
+    cdl_scene_settings settings; /* what the file says about rendering (cdl_scene_open) */
 } cdl_scene;
 
 enum { CDL_TRI_HAS_N = 1, CDL_TRI_HAS_UV = 2 };

@@ -1,9 +1,8 @@
-#include "cli/pm_args.h"
+#include "api/method_settings.h"
 
-#include <stdio.h>
 #include <string.h>
 
-#include "cli/args.h"
+#include "api/parse.h"
 #include "spatial/photon_map.h"
 #include "transport/light_select.h"
 
@@ -120,46 +119,4 @@ int cdl_pm_args_check(const cdl_pm_options *pm, cdl_error *err)
     if (pm->discard && !pm->importance)
         return cdl_error_set(err, CDL_ERR_USAGE, "--importance-discard", 0, "needs --importance");
     return 0;
-}
-
-void cdl_pm_args_help(void)
-{
-    printf("Photon mapping (pm; Jensen 1996 with Keller & Wald 2000):\n"
-           "      --photons N         global photons stored per pass (default 100000); paths\n"
-           "                          are traced until the map holds N\n"
-           "      --knn K             photons per radiance estimate (default 50)\n"
-           "      --max-radius R      largest estimate radius (default 5 %% of the diagonal)\n"
-           "      --kernel KIND       box, cone (default) or epanechnikov\n"
-           "      --gather N          final gathering rays per pixel sample (default 8);\n"
-           "                          0 shows the global map directly\n"
-           "      --precompute M      gather rays landing on Lambertian surfaces read the\n"
-           "                          irradiance precomputed at 1 in M photons from the\n"
-           "                          others (Christensen 1999; default 4, 0 = a full\n"
-           "                          estimate; M >= 2)\n"
-           "      --visibility V      which estimates leave out photons hidden from the query\n"
-           "                          point (a shadow ray each): gather (default: those at\n"
-           "                          final-gather hits, incl. the precomputed irradiance),\n"
-           "                          all (also --gather 0 and caustics at the camera's\n"
-           "                          point) or off (Jensen's: leaks through thin walls)\n"
-           "      --caustic-ratio q   only a fraction q of the paths fills the global map,\n"
-           "                          all fill the caustic map (default 1)\n"
-           "      --caustic-select S  prefix (the first q N paths, default) or random (a\n"
-           "                          test against q per photon)\n"
-           "      --importance        store photons with probability p = min(1, f I(x)) from\n"
-           "                          importons traced from the camera (power L / p)\n"
-           "      --importons N       importon paths (default 131072)\n"
-           "      --importance-eps e  lower bound of p, in (0, 1] (default 0.01; unbiased)\n"
-           "      --importance-discard  drop photons with p < e instead (biased)\n"
-           "      --direct KIND       power (default: lights in proportion to power), lcon\n"
-           "                          (S rays to the lights of nearby primary photons, one to\n"
-           "                          the rest), lcon-biased (none to the rest) or photons\n"
-           "                          (read from the photon map: its primary photons seen\n"
-           "                          directly; needs --gather 0) or none (indirect light\n"
-           "                          alone, for comparisons)\n"
-           "      --shadow-rays S     direct-light shadow rays per shading point (default 4)\n"
-           "      --lcon-radius R     radius of the L_con query (default: --max-radius)\n"
-           "      --photon-paths-max N  give up when N paths per pass have not stored\n"
-           "                          --photons photons (default 1000 per photon, at\n"
-           "                          least 2^20)\n"
-           "\n");
 }

@@ -1,9 +1,8 @@
-#include "cli/gkde_args.h"
+#include "api/method_settings.h"
 
-#include <stdio.h>
 #include <string.h>
 
-#include "cli/args.h"
+#include "api/parse.h"
 
 static const char *valued[] = {"--eye-paths", "--links", "--bandwidth", "--path-memory", "--footprint-cap"};
 
@@ -37,19 +36,4 @@ int cdl_gkde_arg(const char *o, const char *v, cdl_gkde_options *g, cdl_error *e
         g->max_mib = (uint32_t)l;
     }
     return rc;
-}
-
-void cdl_gkde_args_help(void)
-{
-    printf("Generalized kernel density estimation (gkde; Bekaert et al. 2003):\n"
-           "      --light-paths N     light paths per step (default 100000)\n"
-           "      --eye-paths N       eye paths per pixel and step (default 1)\n"
-           "      --links M           unoccluded links wanted per eye vertex (default 10)\n"
-           "      --bandwidth h       footprint bandwidth of eq. 7 (default: calibrated in\n"
-           "                          the first step so that an eye vertex lies in about M\n"
-           "                          first-bounce footprints)\n"
-           "      --footprint-cap F   footprint radii at most F times the median\n"
-           "                          first-bounce one (default 2; 0: eq. 7 unbounded)\n"
-           "      --path-memory MiB   cap on the stored light and eye vertices (default 4096)\n"
-           "\n");
 }

@@ -1,9 +1,8 @@
-#include "cli/splat_args.h"
+#include "api/method_settings.h"
 
-#include <stdio.h>
 #include <string.h>
 
-#include "cli/args.h"
+#include "api/parse.h"
 
 static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
                                "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max",
@@ -113,56 +112,4 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
             rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
     }
     return rc;
-}
-
-void cdl_splat_args_help(void)
-{
-    printf("Photon ray splatting (splat; Herzog et al. 2007):\n"
-           "      --photons M         photon rays stored per pass, all budgets (default 200000)\n"
-           "      --fractions d,i,c   shares of direct, indirect and caustic rays (default\n"
-           "                          0.3,0.6,0.1)\n"
-           "      -C c                bandwidth smoothness (default 1.0): mean kernel radius\n"
-           "                          C * 0.2 * the mean photon ray length at 10^5 photons\n"
-           "      -S s                bandwidth sensitivity to the path density, 0..1 (default\n"
-           "                          0.4; 0: one bandwidth for all rays)\n"
-           "      -R r                bandwidth clamping, 0..1 (default 0.2): radii within\n"
-           "                          [r, 1/r] times the mean\n"
-           "      --mode KIND         radiance maps: direct (BSDF per splat), histogram (20\n"
-           "                          strata), sh (16 coefficients) (default direct)\n"
-           "      --direct KIND       photons (direct light splatted, default), sample\n"
-           "                          (light sampling at the eye samples) or none (indirect\n"
-           "                          light alone)\n"
-           "      --eye-samples N     eye samples per pixel and pass (default 1)\n"
-           "      --cull-nodes on|off back-face-culling nodes in the eye-sample tree (default on)\n"
-           "      --filter N          image-space filtering of the radiance maps (§6.2): each\n"
-           "                          pixel averaged over a box of its own surface segment,\n"
-           "                          the smallest holding N photon splats (0: off; default)\n"
-           "      --filter-normal DEG segments: neighbours' normals within DEG (default 20)\n"
-           "      --filter-depth T    segments: second difference of 1/depth within T of it\n"
-           "                          (default 0.05)\n"
-           "      --filter-max R      largest box: (2R+1)^2 pixels (default 25)\n"
-           "      --cache EPS         radiance caching (§6.3) with cache error EPS (0: off;\n"
-           "                          default): the maps computed at records only, by\n"
-           "                          splatting, and interpolated within radius EPS R (R: the\n"
-           "                          harmonic mean distance of the rays, 2 to 50 pixels)\n"
-           "      --cache-min N       records each pixel gathers from, N_c (default 5)\n"
-           "      --cache-weight KIND report (eq. 6.7; default) or ward (Ward 1988)\n"
-           "      --cache-spacing KIND gradient (R shrunk where the splats' irradiance\n"
-           "                          gradient is steep, eq. 6.12; default) or geometric\n"
-           "      --gather N          final gathering (§6.4): N rays per camera sample by BSDF\n"
-           "                          sampling; photon rays splat to where they land (rows\n"
-           "                          in bands of at most 2^20 eye samples), light sampled\n"
-           "                          at the camera's point (default 0: off)\n"
-           "      --visibility-mask on|off  eye samples hidden from a photon ray by other eye\n"
-           "                          samples in its frustum get none of its light (§8.1;\n"
-           "                          default off; not with --cache)\n"
-           "      --traversal KIND    how a photon ray finds its eye samples: sphere (each\n"
-           "                          node's bounding sphere against the frustum; default) or\n"
-           "                          slabs (the report's Algorithm 1: the same samples, about\n"
-           "                          twice as many tested)\n"
-           "      --cap KIND          eye samples beyond a photon ray's hit: plane (fed if the\n"
-           "                          ray reached their tangent plane, out to 4 h: consistent;\n"
-           "                          default) or hemisphere (the report's Algorithm 2: biased\n"
-           "                          low at oblique incidence, whatever h)\n"
-           "\n");
 }

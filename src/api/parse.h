@@ -1,7 +1,7 @@
-/* Checked parsing of command-line values: every number is validated and
+/* Checked parsing of option values: every number is validated and
  * an error names the option, the accepted range and what was given. */
-#ifndef CDL_ARGS_H
-#define CDL_ARGS_H
+#ifndef CDL_PARSE_H
+#define CDL_PARSE_H
 
 #include <stdint.h>
 

@@ -1,0 +1,41 @@
+/* The candela command: a driver over the public API (candela.h) alone. */
+#ifndef CLI_H
+#define CLI_H
+
+#include <candela/candela.h>
+#include <stdio.h>
+
+#define CLI_MAX_OUT 8
+
+/* What `candela render` and `candela photons` take besides the settings. */
+typedef struct cli_args {
+    const char *scene;
+    const char *out[CLI_MAX_OUT];
+    int nout;
+    int quiet, aov;
+} cli_args;
+
+/* Parses argv[1..] into s and a; -1 after --help (printed), else 0 or an
+ * error. what names the command in messages. */
+int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *err);
+/* Prints "candela: error: ..." for err and returns its exit status. */
+int cli_report(const cdl_error *err);
+/* 1 if path ends in ext (".exr"), case-insensitive. */
+int cli_has_ext(const char *path, const char *ext);
+
+int cli_render(int argc, char **argv);
+int cli_photons(int argc, char **argv);
+int cli_diff(int argc, char **argv);
+
+double cli_now(void); /* monotonic seconds */
+
+/* A progress bar on stderr when it is a terminal. */
+typedef struct cli_bar {
+    double start, last;
+    int active, drawn;
+} cli_bar;
+void cli_bar_begin(cli_bar *b, int quiet);
+void cli_bar_update(cli_bar *b, double frac, double elapsed, const char *label);
+void cli_bar_end(cli_bar *b);
+
+#endif
