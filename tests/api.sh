@@ -5,7 +5,8 @@
 #   all cdl_-prefixed, and nothing else;
 # - candela.h compiles alone as C11 and C++17 with -Wall -Wextra -pedantic;
 # - the candela command's sources include nothing but the public header and
-#   their own (the build has no src/ on their include path either).
+#   their own (the build has no src/ on their include path either), and the
+#   library includes nothing of the command's.
 set -eu
 lib=$1 src=$2
 fail=0
@@ -29,5 +30,7 @@ c++ -std=c++17 -Wall -Wextra -pedantic -Werror -I"$src/include" -c "$tmp/c.cpp" 
   { echo "FAIL: candela.h as C++17"; fail=1; }
 inc=$(grep -h '^#include "' "$src"/src/cli/*.c "$src"/src/cli/*.h | grep -v '"cli.h"' || true)
 [ -z "$inc" ] || { echo "FAIL: the CLI includes internal headers: $inc"; fail=1; }
+up=$(grep -rl '#include "cli' "$src/src" --include='*.[ch]' | grep -v '/src/cli/' || true)
+[ -z "$up" ] || { echo "FAIL: the library includes the driver: $up"; fail=1; }
 [ $fail -eq 0 ] && echo "ok: $n exported functions, all declared in candela.h; header clean as C11 and C++17; CLI on the public API"
 exit $fail

@@ -196,8 +196,9 @@ CDL_API int cdl_renderer_render(cdl_renderer *r, cdl_progress_fn progress, void 
  * image between them. */
 CDL_API int cdl_renderer_render_passes(cdl_renderer *r, uint32_t n, cdl_progress_fn progress, void *user,
                                        cdl_error *err);
-/* Stops the render of r after the current pass (its tiles stop early, so
- * that pass does not count). Safe from any thread and from a signal handler. */
+/* Stops the render of r under way after the current pass (its tiles stop
+ * early, so that pass does not count); a cancel while r is not rendering
+ * has no effect. Safe from any thread and from a signal handler. */
 CDL_API void cdl_renderer_cancel(cdl_renderer *r);
 /* 1 if the last render of r ended by cancel (or a progress callback). */
 CDL_API int cdl_renderer_cancelled(const cdl_renderer *r);

@@ -147,9 +147,32 @@ class _Settings:
             self.h = None
 
 
-class Scene:
+class _Handle:
+    """A C handle given back by _release when closed, collected or left."""
+
+    h = None
+    _release = None
+
+    def close(self):
+        if self.h:
+            type(self)._release(self.h)
+            self.h = None
+
+    def __del__(self):
+        self.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class Scene(_Handle):
     """A loaded scene (OBJ + MTL or pbrt-v3/v4). point_light= adds point
     lights: (x, y, z, r, g, b) or a list of them; quiet=True drops warnings."""
+
+    _release = lib.cdl_scene_release
 
     def __init__(self, path, point_light=None, quiet=None):
         self.path = str(path)
@@ -170,19 +193,6 @@ class Scene:
                 "bounds": (tuple(i.bounds_min), tuple(i.bounds_max)), "has_camera": bool(i.has_camera),
                 "res": (i.width, i.height), "spp": i.spp}
 
-    def close(self):
-        if self.h:
-            lib.cdl_scene_release(self.h)
-            self.h = None
-
-    def __del__(self):
-        self.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def _to_array(h):
@@ -206,7 +216,7 @@ def _from_array(a):
     return h.value
 
 
-class Renderer:
+class Renderer(_Handle):
     """One method on one scene, rendered in progressive passes:
 
         r = Renderer(scene, integrator="pm", photons=50000, res=(256, 256))
@@ -214,6 +224,8 @@ class Renderer:
             r.render_passes(1)
             errors.append(diff(r.image(), ref)["relmse"])
     """
+
+    _release = lib.cdl_renderer_release
 
     def __init__(self, scene, integrator=None, args=None, **opts):
         """args: command-line words (["-i", "bdpt", "--mis", "power"]), read
@@ -316,19 +328,6 @@ class Renderer:
         """EXR (with the AOV layers), PNG or PFM, by the extension."""
         _call(lib.cdl_renderer_write, self.h, str(path).encode(), command_line.encode() if command_line else None)
 
-    def close(self):
-        if self.h:
-            lib.cdl_renderer_release(self.h)
-            self.h = None
-
-    def __del__(self):
-        self.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def render(scene, integrator=None, spp=None, time=None, stats=False, progress=None, args=None, **opts):

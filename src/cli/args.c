@@ -167,3 +167,22 @@ int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *er
     }
     return 0;
 }
+
+int cli_begin(int argc, char **argv, cdl_settings **s, cli_args *a, int *status)
+{
+    cdl_error err;
+    *s = cdl_settings_create();
+    if (!*s) {
+        fprintf(stderr, "candela: error: out of memory\n");
+        *status = 1;
+        return 1;
+    }
+    int rc = cli_parse(argc, argv, *s, a, &err);
+    if (rc) {
+        cdl_settings_release(*s);
+        *s = NULL;
+        *status = rc < 0 ? 0 : cli_report(&err);
+        return 1;
+    }
+    return 0;
+}

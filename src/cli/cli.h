@@ -18,6 +18,9 @@ typedef struct cli_args {
 /* Parses argv[1..] into s and a; -1 after --help (printed), else 0 or an
  * error. what names the command in messages. */
 int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *err);
+/* Makes *s and parses into it; 1 when the command ends here (after --help
+ * or an error, reported), with *status its exit status. */
+int cli_begin(int argc, char **argv, cdl_settings **s, cli_args *a, int *status);
 /* Prints "candela: error: ..." for err and returns its exit status. */
 int cli_report(const cdl_error *err);
 /* 1 if path ends in ext (".exr"), case-insensitive. */

@@ -43,16 +43,10 @@ int cli_render(int argc, char **argv)
 {
     cdl_error err;
     cli_args a;
-    cdl_settings *s = cdl_settings_create();
-    if (!s) {
-        fprintf(stderr, "candela: error: out of memory\n");
-        return 1;
-    }
-    int rc = cli_parse(argc, argv, s, &a, &err);
-    if (rc) {
-        cdl_settings_release(s);
-        return rc < 0 ? 0 : cli_report(&err);
-    }
+    cdl_settings *s;
+    int rc;
+    if (cli_begin(argc, argv, &s, &a, &rc))
+        return rc;
     double t_load = cli_now();
     cdl_scene *scene = NULL;
     cdl_renderer *r = NULL;
