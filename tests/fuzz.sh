@@ -15,6 +15,7 @@ shift $(( $# < 4 ? $# : 4 ))
 targets=${*:-obj pbrt ply image options}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+export LSAN_OPTIONS="suppressions=$src/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 [ -n "$root" ] || root=$tmp/corpora
 mkdir -p "$root"
 
@@ -50,6 +51,8 @@ seed() { # seed TARGET DIR
 
 run() { # run TARGET: regressions, then fuzzing
   local t=$1 bin=$build/fuzz/fuzz_$1 log=$tmp/$1.log
+  # the OBJ target's leak suppression (fuzz/lsan.supp) needs whole stacks
+  [ "$t" = obj ] && export ASAN_OPTIONS="fast_unwind_on_malloc=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
   local art=$root/$t-artifacts/
   mkdir -p "$art" "$root/$t"
   local regs=("$src"/fuzz/regressions/"$t"/*)

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "scene/obj_check.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stb_image.h>
@@ -256,6 +257,11 @@ static int obj_numbers(obj_ctx *c, line_cursor *lc, const char *key, int line, i
         float v;
         if (parse_float(w, &v))
             return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, line, "%s: '%s' is not a number", key, w);
+        /* Assimp counts a vertex's numbers by their first character and
+         * silently drops a vertex with a number such as ".5" */
+        if (!isdigit((unsigned char)w[0]) && w[0] != '-' && w[0] != '+')
+            return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, line,
+                                 "%s: write '%s' with a digit first (as 0%s): the importer misreads it", key, w, w);
         if (!isfinite(v) || fabsf(v) > limit)
             return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, line,
                                  "%s: coordinate %s is not finite or beyond %g", key, w, (double)limit);
