@@ -52,8 +52,8 @@ static const cdl_option_info *find(const char *o)
     return NULL;
 }
 
-/* text wrapped to 80 columns, continuation lines indented by 26 */
-static void wrapped(const char *text, int col)
+/* text from column col, wrapped at 80 columns, continuation lines indented */
+static void wrapped(const char *text, int col, int indent)
 {
     const char *p = text;
     while (*p) {
@@ -67,11 +67,11 @@ static void wrapped(const char *text, int col)
             cut--;
         if (cut == 0)
             cut = room;
-        printf("%.*s\n%26s", cut, p, "");
+        printf("%.*s\n%*s", cut, p, indent, "");
         p += cut;
         while (*p == ' ')
             p++;
-        col = 26;
+        col = indent;
     }
 }
 
@@ -101,12 +101,12 @@ static void help(void)
                  o->value[0] && o->default_value[0] && !strstr(o->help, "default") ? ")" : "");
         int len = (int)strlen(left);
         printf("%s%*s", left, len < 26 ? 26 - len : 2, "");
-        wrapped(text, len < 26 ? 26 : len + 2);
+        wrapped(text, len < 26 ? 26 : len + 2, 26);
     }
     printf("\nIntegrators:\n");
     for (int i = 0; i < cdl_integrator_count(); i++) {
         printf("  %-8s ", cdl_integrator_name(i));
-        wrapped(cdl_integrator_summary(i), 11);
+        wrapped(cdl_integrator_summary(i), 11, 11);
     }
     printf("\nThe summary line gives wall time, samples per pixel and Mrays/s (all rays\n"
            "traced divided by the render time). Ctrl-C writes the image so far (exit 130).\n");
