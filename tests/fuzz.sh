@@ -63,7 +63,12 @@ run() { # run TARGET: regressions, then fuzzing
   local n=$(ls "$tmp/seed-$t" | wc -l)
   if ! "$bin" -max_total_time="$secs" -timeout=20 -rss_limit_mb=4096 -print_final_stats=1 \
        -artifact_prefix="$art" "$root/$t" "$tmp/seed-$t" > "$log" 2>&1; then
-    echo "FAIL fuzz_$t (input in $art):"; grep -A30 -m1 -E "ERROR|runtime error|Sanitizer|timeout|deadly" "$log" | head -40
+    echo "FAIL fuzz_$t (input in $art):"
+    if grep -q -E "ERROR|runtime error|Sanitizer|timeout|deadly" "$log"; then
+      grep -A30 -m1 -E "ERROR|runtime error|Sanitizer|timeout|deadly" "$log" | head -40
+    else
+      tail -20 "$log"
+    fi
     return 1
   fi
   local execs cov ft

@@ -59,7 +59,7 @@ static cdl_vec3 emitted(const cdl_scene *s, int32_t light, cdl_vec3 o, cdl_vec3 
                         cdl_vec3 ng, int specular, float pdf_prev)
 {
     const cdl_light *l = &s->lights[light];
-    cdl_vec3 Le = l->type == CDL_LIGHT_INFINITE ? l->L : cdl_light_Le(l, ng, cdl_neg(d));
+    cdl_vec3 Le = l->type == CDL_LIGHT_INFINITE ? cdl_light_env_Le(l, d) : cdl_light_Le(l, ng, cdl_neg(d));
     if (specular || cdl_is_black(Le))
         return Le;
     float pdf_l = s->light_select.pmf[light] * cdl_light_pdf_li(l, o, d, t);

@@ -3,6 +3,7 @@
 #include <float.h>
 
 #include "core/sampling.h"
+#include "scene/envmap.h"
 
 /* A uniform point on a triangle light. */
 static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2)
@@ -121,11 +122,17 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
         s->delta = 1;
         return 1;
     case CDL_LIGHT_INFINITE:
-        s->wi = cdl_sample_uniform_sphere(u1, u2);
+        if (l->map) {
+            s->Li = cdl_envmap_sample(l->map, u1, u2, &s->wi, &s->pdf);
+            if (!(s->pdf > 0.0f))
+                return 0;
+        } else {
+            s->wi = cdl_sample_uniform_sphere(u1, u2);
+            s->Li = l->L;
+            s->pdf = 0.25f * CDL_INV_PI;
+        }
         s->dist = FLT_MAX;
         s->p = cdl_madd(ref, s->wi, 2.0f * l->radius);
-        s->Li = l->L;
-        s->pdf = 0.25f * CDL_INV_PI;
         s->delta = 0;
         return 1;
     case CDL_LIGHT_SPHERE:
@@ -171,7 +178,7 @@ float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist
         return 1.0f / (2.0f * CDL_PI * one_minus_cos_max(r2 / d2));
     }
     case CDL_LIGHT_INFINITE:
-        return 0.25f * CDL_INV_PI;
+        return l->map ? cdl_envmap_pdf(l->map, wi) : 0.25f * CDL_INV_PI;
     default:
         return 0.0f;
     }
@@ -214,8 +221,15 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
         /* a ray entering the scene's bounding sphere: a disk perpendicular
          * to the direction, pushed out to the sphere */
         float pdf_dir = 1.0f;
+        e->Le = l->L;
         if (l->type == CDL_LIGHT_DISTANT) {
             e->d = l->n;
+        } else if (l->map) { /* travelling away from where the light comes from */
+            cdl_vec3 w;
+            e->Le = cdl_envmap_sample(l->map, u3, u4, &w, &pdf_dir);
+            if (!(pdf_dir > 0.0f))
+                return 0;
+            e->d = cdl_neg(w);
         } else {
             e->d = cdl_sample_uniform_sphere(u3, u4);
             pdf_dir = 0.25f * CDL_INV_PI;
@@ -225,7 +239,6 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
         e->p = cdl_add(l->p, cdl_scale(cdl_add(cdl_scale(f.t, disk.x), cdl_scale(f.b, disk.y)), l->radius));
         e->p = cdl_madd(e->p, e->d, -l->radius);
         e->n = e->d;
-        e->Le = l->L;
         e->pdf_pos = 1.0f / (CDL_PI * l->radius * l->radius);
         e->pdf_dir = pdf_dir;
         return 1;
@@ -263,12 +276,18 @@ cdl_vec3 cdl_light_power(const cdl_light *l)
         return cdl_scale(l->L, 2.0f * CDL_PI * (1.0f - 0.5f * (l->cos_falloff + l->cos_total)));
     case CDL_LIGHT_DISTANT:
         return cdl_scale(l->L, CDL_PI * l->radius * l->radius);
-    case CDL_LIGHT_INFINITE:
-        return cdl_scale(l->L, 4.0f * CDL_PI * CDL_PI * l->radius * l->radius);
+    case CDL_LIGHT_INFINITE: /* the flux through the disk facing each direction */
+        return cdl_scale(l->map ? l->map->flux : cdl_scale(l->L, 4.0f * CDL_PI),
+                         CDL_PI * l->radius * l->radius);
     case CDL_LIGHT_SPHERE:
         return cdl_scale(l->L, CDL_PI * l->area);
     case CDL_LIGHT_TRIANGLE:
         break;
     }
     return cdl_scale(l->L, CDL_PI * l->area * (l->twosided ? 2.0f : 1.0f));
+}
+
+cdl_vec3 cdl_light_env_Le(const cdl_light *l, cdl_vec3 w)
+{
+    return l->map ? cdl_envmap_eval(l->map, w) : l->L;
 }

@@ -19,6 +19,8 @@ typedef enum cdl_light_type {
     CDL_LIGHT_INFINITE
 } cdl_light_type;
 
+struct cdl_envmap;
+
 typedef struct cdl_light {
     cdl_light_type type;
     cdl_vec3 p;      /* triangle vertex 0; sphere centre; point/spot position;
@@ -33,6 +35,7 @@ typedef struct cdl_light {
     int twosided;    /* triangle: emits from both faces */
     int inward;      /* sphere: emits towards its inside (ReverseOrientation) */
     uint32_t prim;   /* triangle or sphere index in the scene */
+    const struct cdl_envmap *map; /* infinite: its radiance map (NULL: constant L) */
 } cdl_light;
 
 typedef struct cdl_light_sample {
@@ -67,6 +70,9 @@ float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist
 cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo);
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,
                         cdl_light_emit *e);
+/* Radiance of an infinite light arriving from world direction w (unit,
+ * pointing away from the scene): its map's, or the constant L. */
+cdl_vec3 cdl_light_env_Le(const cdl_light *l, cdl_vec3 w);
 /* Emitted flux (RGB), for power-proportional light selection. */
 cdl_vec3 cdl_light_power(const cdl_light *l);
 

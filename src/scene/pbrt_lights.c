@@ -1,6 +1,7 @@
 /* pbrt light sources: LightSource point / spot / distant / infinite, and
  * AreaLightSource "diffuse", which sets the emission of the shapes that
  * follow in the same attribute block (pbrt_shapes.c attaches it). */
+#include <stdlib.h>
 #include <string.h>
 
 #include "scene/pbrt_internal.h"
@@ -82,16 +83,34 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         return cdl_pbrt_scene_rc(c, cdl_scene_add_point_light(c->s, P, v, err));
     }
     if (is_inf) {
-        const char *map;
-        if ((rc = cdl_pbrt_get_string(ps, "mapname", NULL, &map, err)))
+        const char *map, *v4map;
+        if ((rc = cdl_pbrt_get_string(ps, "mapname", NULL, &map, err)) ||
+            (rc = cdl_pbrt_get_string(ps, "filename", NULL, &v4map, err)))
             return rc;
-        if (!map && (rc = cdl_pbrt_get_string(ps, "filename", NULL, &map, err)))
-            return rc;
-        if (map)
-            cdl_pbrt_warn(c, c->line, "environment map \"%s\" ignored: only the constant L is used", map);
+        if (v4map) /* pbrt-v4: an equal-area octahedral square map */
+            cdl_pbrt_warn(c, c->line, "pbrt-v4 environment map \"%s\" (equal-area) is not supported yet: the "
+                          "constant L is used", v4map);
         cdl_pbrt_find(ps, "samples");
         cdl_pbrt_find(ps, "nsamples");
-        return cdl_pbrt_scene_rc(c, cdl_scene_add_infinite_light(c->s, v, err));
+        if (!map)
+            return cdl_pbrt_scene_rc(c, cdl_scene_add_infinite_light(c->s, v, err));
+        /* pbrt-v3: equirectangular in the light's frame (the CTM), L scales it */
+        char path[1024];
+        cdl_pbrt_resolve(c, map, path, sizeof path);
+        cdl_vec3 frame[3];
+        for (int k = 0; k < 3; k++) {
+            double axis[3] = {k == 0, k == 1, k == 2}, w[3];
+            cdl_mat4_vector(m, axis, w);
+            frame[k] = cdl_v3((float)w[0], (float)w[1], (float)w[2]);
+        }
+        cdl_envmap *em = malloc(sizeof *em);
+        if (!em)
+            return cdl_pbrt_error(c, c->line, "out of memory");
+        if ((rc = cdl_envmap_load(em, path, v, frame, err))) {
+            free(em);
+            return rc;
+        }
+        return cdl_pbrt_scene_rc(c, cdl_scene_add_env_light(c->s, cdl_v3(1, 1, 1), em, err));
     }
     if (!(cdl_length(D) > 0.0f) || !cdl_is_finite3(D))
         return cdl_pbrt_error(c, c->line, "LightSource \"%s\": 'from' and 'to' must differ", type);

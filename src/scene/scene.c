@@ -52,6 +52,9 @@ void cdl_scene_free(cdl_scene *s)
         cdl_texture_free(&s->texs[i]);
     free(s->texs);
     free(s->lights);
+    if (s->envmap)
+        cdl_envmap_free(s->envmap);
+    free(s->envmap);
     cdl_alias_free(&s->light_select);
     memset(s, 0, sizeof *s);
 }
@@ -258,17 +261,29 @@ int cdl_scene_add_distant_light(cdl_scene *s, cdl_vec3 dir, cdl_vec3 L, cdl_erro
 
 int cdl_scene_add_infinite_light(cdl_scene *s, cdl_vec3 L, cdl_error *err)
 {
+    return cdl_scene_add_env_light(s, L, NULL, err);
+}
+
+int cdl_scene_add_env_light(cdl_scene *s, cdl_vec3 L, cdl_envmap *map, cdl_error *err)
+{
     int rc = check_light(s, cdl_v3(0, 0, 0), L, err);
-    if (rc)
-        return rc;
-    for (uint32_t i = 0; i < s->nlights; i++)
+    for (uint32_t i = 0; !rc && i < s->nlights; i++)
         if (s->lights[i].type == CDL_LIGHT_INFINITE)
-            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "only one infinite light is supported");
+            rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "only one infinite light is supported");
     cdl_light l;
     memset(&l, 0, sizeof l);
     l.type = CDL_LIGHT_INFINITE;
     l.L = L;
-    return add_light(s, &l, err);
+    l.map = map;
+    if (!rc)
+        rc = add_light(s, &l, err);
+    if (rc && map) {
+        cdl_envmap_free(map);
+        free(map);
+    } else if (map) {
+        s->envmap = map;
+    }
+    return rc;
 }
 
 /* Area lights from emitting shapes; bounds-dependent lights finished. */

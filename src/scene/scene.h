@@ -12,6 +12,7 @@
 #include "core/alias.h"
 #include "core/error.h"
 #include "scene/bsdf.h"
+#include "scene/envmap.h"
 #include "scene/light.h"
 #include "scene/material.h"
 #include "scene/texture.h"
@@ -74,6 +75,7 @@ typedef struct cdl_scene {
     cdl_alias light_select;
 
     int32_t env_light;   /* index of the infinite light or -1 (after commit) */
+    cdl_envmap *envmap;  /* its radiance map, or NULL */
     cdl_vec3 bmin, bmax; /* bounds of the geometry (after commit) */
     float eps;           /* ray offset scale (after commit) */
     char path[1024];     /* file the scene came from, for messages */
@@ -107,6 +109,9 @@ int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I,
 int cdl_scene_add_distant_light(cdl_scene *s, cdl_vec3 dir, cdl_vec3 L, cdl_error *err);
 /* Constant radiance L from every direction (at most one). */
 int cdl_scene_add_infinite_light(cdl_scene *s, cdl_vec3 L, cdl_error *err);
+/* An infinite light with radiance map (malloc'd, taken over, freed on error
+ * too; NULL: constant L). */
+int cdl_scene_add_env_light(cdl_scene *s, cdl_vec3 L, cdl_envmap *map, cdl_error *err);
 int cdl_scene_commit(cdl_scene *s, cdl_error *err);
 
 /* ---- ray queries ---- */

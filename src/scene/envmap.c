@@ -1,0 +1,207 @@
+#include "scene/envmap.h"
+
+#include <math.h>
+#include <stb_image.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "film/image.h"
+
+static float clampf(float x, float lo, float hi)
+{
+    return x < lo ? lo : x > hi ? hi : x;
+}
+
+void cdl_envmap_free(cdl_envmap *m)
+{
+    free(m->rgb);
+    free(m->func);
+    free(m->cdf_row);
+    free(m->cdf_col);
+    memset(m, 0, sizeof *m);
+}
+
+/* Running sums of f[0..n) into cdf[0..n], normalized to end at 1; returns
+ * the sum (a zero sum gives a uniform cdf). */
+static double build_cdf(const float *f, int n, float *cdf)
+{
+    double sum = 0.0;
+    cdf[0] = 0.0f;
+    for (int i = 0; i < n; i++) {
+        sum += f[i];
+        cdf[i + 1] = (float)sum;
+    }
+    for (int i = 1; i <= n; i++)
+        cdf[i] = sum > 0.0 ? (float)(cdf[i] / sum) : (float)i / (float)n;
+    cdf[n] = 1.0f;
+    return sum;
+}
+
+/* The index i with cdf[i] <= u < cdf[i + 1], skipping empty bins. */
+static int find(const float *cdf, int n, float u)
+{
+    int lo = 0, hi = n;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (cdf[mid] <= u)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    while (lo < n - 1 && !(cdf[lo + 1] > cdf[lo]))
+        lo++;
+    return lo;
+}
+
+int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 frame[3], cdl_error *err)
+{
+    memset(m, 0, sizeof *m);
+    m->w = w;
+    m->h = h;
+    m->rgb = rgb;
+    /* a right-handed orthonormal frame from the transform's axes */
+    m->ez = cdl_normalize(frame[2]);
+    m->ex = cdl_normalize(cdl_sub(frame[0], cdl_scale(m->ez, cdl_dot(frame[0], m->ez))));
+    m->ey = cdl_cross(m->ez, m->ex);
+    if (!cdl_is_finite3(m->ex) || !cdl_is_finite3(m->ez) || !(cdl_length(m->ex) > 0.5f)) {
+        m->rgb = NULL;
+        return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "environment map transform is degenerate");
+    }
+    size_t n = (size_t)w * (size_t)h;
+    m->func = malloc(sizeof(float) * n);
+    m->cdf_row = malloc(sizeof(float) * ((size_t)h + 1));
+    m->cdf_col = malloc(sizeof(float) * (size_t)h * ((size_t)w + 1));
+    float *rows = malloc(sizeof(float) * (size_t)h);
+    if (!m->func || !m->cdf_row || !m->cdf_col || !rows) {
+        free(rows);
+        cdl_envmap_free(m);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for a %dx%d environment map", w, h);
+    }
+    double total = 0.0;
+    cdl_vec3 flux = cdl_v3(0.0f, 0.0f, 0.0f);
+    for (int y = 0; y < h; y++) {
+        float th0 = CDL_PI * (float)y / (float)h, th1 = CDL_PI * (float)(y + 1) / (float)h;
+        float sin_c = sinf(0.5f * (th0 + th1));
+        /* the solid angle of a texel of this row */
+        float dw = 2.0f * CDL_PI / (float)w * (cosf(th0) - cosf(th1));
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            cdl_vec3 L = cdl_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+            m->func[i] = cdl_maxf(cdl_luminance(L), 0.0f) * sin_c;
+            flux = cdl_add(flux, cdl_scale(L, dw));
+        }
+        rows[y] = (float)build_cdf(m->func + (size_t)y * (size_t)w, w, m->cdf_col + (size_t)y * ((size_t)w + 1));
+        total += rows[y];
+    }
+    build_cdf(rows, h, m->cdf_row);
+    free(rows);
+    m->flux = flux;
+    m->mean = (float)(total / (double)n);
+    return 0;
+}
+
+int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_vec3 frame[3], cdl_error *err)
+{
+    memset(m, 0, sizeof *m);
+    cdl_image img = {0};
+    int rc = 0;
+    if (cdl_image_has_ext(path, ".hdr")) {
+        int w, h, n;
+        float *px = stbi_loadf(path, &w, &h, &n, 3);
+        if (!px)
+            return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "cannot read the Radiance HDR image (%s)",
+                                 stbi_failure_reason());
+        rc = cdl_image_alloc(&img, w, h, err);
+        if (!rc)
+            memcpy(img.rgb, px, sizeof(float) * 3 * (size_t)w * (size_t)h);
+        stbi_image_free(px);
+    } else {
+        rc = cdl_image_read(path, &img, err);
+    }
+    if (rc)
+        return err && !err->file[0] ? cdl_error_set(err, err->code, path, 0, "%s", err->msg) : rc;
+    size_t n = (size_t)img.width * (size_t)img.height;
+    for (size_t i = 0; i < 3 * n; i++) {
+        float s = i % 3 == 0 ? scale.x : i % 3 == 1 ? scale.y : scale.z;
+        float v = img.rgb[i] * s;
+        if (!isfinite(v) || v < 0.0f) {
+            cdl_image_free(&img);
+            return cdl_error_set(err, CDL_ERR_INPUT, path, 0,
+                                 "texel (%zu, %zu) is negative, NaN or infinite: not a radiance", (i / 3) % (size_t)img.width,
+                                 (i / 3) / (size_t)img.width);
+        }
+        img.rgb[i] = v;
+    }
+    rc = cdl_envmap_init(m, img.width, img.height, img.rgb, frame, err);
+    if (rc) {
+        cdl_image_free(&img);
+        if (err && !err->file[0])
+            snprintf(err->file, sizeof err->file, "%s", path);
+    }
+    return rc;
+}
+
+/* (u, v) in [0,1)^2 of world direction w, and sin(theta) there. */
+static void to_uv(const cdl_envmap *m, cdl_vec3 w, float *u, float *v)
+{
+    float x = cdl_dot(w, m->ex), y = cdl_dot(w, m->ey), z = cdl_dot(w, m->ez);
+    float th = atan2f(sqrtf(x * x + y * y), z); /* acos(z) loses the poles to rounding */
+    float ph = atan2f(y, x);
+    if (ph < 0.0f)
+        ph += 2.0f * CDL_PI;
+    *u = ph * (0.5f * CDL_INV_PI);
+    *v = th * CDL_INV_PI;
+}
+
+static size_t texel(const cdl_envmap *m, float u, float v)
+{
+    int x = (int)(u * (float)m->w), y = (int)(v * (float)m->h);
+    x = x < 0 ? 0 : x >= m->w ? m->w - 1 : x;
+    y = y < 0 ? 0 : y >= m->h ? m->h - 1 : y;
+    return (size_t)y * (size_t)m->w + (size_t)x;
+}
+
+cdl_vec3 cdl_envmap_eval(const cdl_envmap *m, cdl_vec3 w)
+{
+    float u, v;
+    to_uv(m, w, &u, &v);
+    size_t i = texel(m, u, v);
+    return cdl_v3(m->rgb[3 * i], m->rgb[3 * i + 1], m->rgb[3 * i + 2]);
+}
+
+float cdl_envmap_pdf(const cdl_envmap *m, cdl_vec3 w)
+{
+    float u, v;
+    to_uv(m, w, &u, &v);
+    float s = sinf(v * CDL_PI);
+    if (!(m->mean > 0.0f) || !(s > 0.0f))
+        return 0.0f;
+    return m->func[texel(m, u, v)] / m->mean / (2.0f * CDL_PI * CDL_PI * s);
+}
+
+cdl_vec3 cdl_envmap_sample(const cdl_envmap *m, float u1, float u2, cdl_vec3 *w, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!(m->mean > 0.0f))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    int y = find(m->cdf_row, m->h, u2);
+    const float *cc = m->cdf_col + (size_t)y * ((size_t)m->w + 1);
+    int x = find(cc, m->w, u1);
+    /* the position within the texel, by the remainders of u1 and u2 */
+    float dy = m->cdf_row[y + 1] - m->cdf_row[y], dx = cc[x + 1] - cc[x];
+    float fy = dy > 0.0f ? (u2 - m->cdf_row[y]) / dy : 0.5f, fx = dx > 0.0f ? (u1 - cc[x]) / dx : 0.5f;
+    /* kept off the texel's edges (a 2e-4 share of it), where rounding
+     * would put the direction into the neighbour */
+    float u = ((float)x + 1e-4f + 0.9998f * clampf(fx, 0.0f, 1.0f)) / (float)m->w;
+    float v = ((float)y + 1e-4f + 0.9998f * clampf(fy, 0.0f, 1.0f)) / (float)m->h;
+    float th = v * CDL_PI, ph = u * 2.0f * CDL_PI;
+    float st = sinf(th);
+    if (!(st > 0.0f))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_vec3 d = cdl_add(cdl_add(cdl_scale(m->ex, st * cosf(ph)), cdl_scale(m->ey, st * sinf(ph))),
+                         cdl_scale(m->ez, cosf(th)));
+    *w = d;
+    size_t i = (size_t)y * (size_t)m->w + (size_t)x;
+    *pdf = m->func[i] / m->mean / (2.0f * CDL_PI * CDL_PI * st);
+    return cdl_v3(m->rgb[3 * i], m->rgb[3 * i + 1], m->rgb[3 * i + 2]);
+}

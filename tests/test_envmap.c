@@ -1,0 +1,231 @@
+/* Environment maps against closed forms:
+ *  - the map's sampling: the returned pdf equals cdl_envmap_pdf, the pdf
+ *    integrates to 1 over the sphere, and E[L / pdf] is the map's flux;
+ *  - a rotated frame turns the map with it;
+ *  - rendered by an integrator (argument, default path): a Lambertian plane
+ *    of albedo rho under two hemispheres of radiance L1 (light +z) and L2
+ *    has radiance rho (L1 + L2) / 2 when it faces the boundary and rho L1
+ *    when it faces +z; a diffuse sphere of albedo a under a constant
+ *    environment of radiance 1 has radiance a, the background 1. */
+#include <math.h>
+#include <string.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "film/image.h"
+#include "scene/envmap.h"
+#include "scene/loader.h"
+#include "test_util.h"
+
+static double tol_scale = 1.0;
+static uint32_t spp_div = 1;
+
+/* Two hemispheres in the light frame: rows above the equator L1, below L2,
+ * with a bright spot so that importance sampling has something to find. */
+static cdl_envmap *two_hemispheres(float L1, float L2, int spot, const cdl_vec3 frame[3])
+{
+    int w = 64, h = 32;
+    float *rgb = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++)
+                rgb[3 * (y * w + x) + c] = y < h / 2 ? L1 : L2;
+    if (spot)
+        for (int c = 0; c < 3; c++)
+            rgb[3 * (5 * w + 9) + c] = 400.0f;
+    cdl_envmap *m = malloc(sizeof *m);
+    cdl_error err;
+    die_on(cdl_envmap_init(m, w, h, rgb, frame, &err), &err);
+    return m;
+}
+
+static const cdl_vec3 zup[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+static void sampling(void)
+{
+    cdl_envmap *m = two_hemispheres(1.0f, 0.25f, 1, zup);
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 7, 0);
+    enum { N = 400000 };
+    double est = 0.0, pdf_int = 0.0, worst = 0.0;
+    for (int i = 0; i < N; i++) {
+        cdl_vec3 w;
+        float pdf;
+        cdl_vec3 L = cdl_envmap_sample(m, cdl_rng_float(&rng), cdl_rng_float(&rng), &w, &pdf);
+        if (pdf > 0.0f) {
+            est += L.x / pdf;
+            worst = fmax(worst, fabs(cdl_envmap_pdf(m, w) / pdf - 1.0));
+        }
+        cdl_vec3 d = cdl_sample_uniform_sphere(cdl_rng_float(&rng), cdl_rng_float(&rng));
+        pdf_int += cdl_envmap_pdf(m, d) * 4.0 * CDL_PI;
+    }
+    est /= N;
+    pdf_int /= N;
+    CHECK(worst < 1e-3, "envmap: pdf of the sampled direction equals the sample's pdf (worst %.2g)", worst);
+    CHECK(fabs(pdf_int - 1.0) < 0.02, "envmap: pdf integrates to %.4f over the sphere (1 within 2 %%)", pdf_int);
+    CHECK(fabs(est / m->flux.x - 1.0) < 0.005, "envmap: E[L/pdf] %.5f vs flux %.5f (within 0.5 %%)", est,
+          (double)m->flux.x);
+    /* flux of the two hemispheres plus the spot texel's solid angle */
+    double th0 = CDL_PI * 5 / 32, th1 = CDL_PI * 6 / 32;
+    double exact = 2.0 * CDL_PI * (1.0 + 0.25) + (400.0 - 1.0) * 2.0 * CDL_PI / 64 * (cos(th0) - cos(th1));
+    CHECK(fabs(m->flux.x / exact - 1.0) < 1e-4, "envmap: flux %.5f vs %.5f", (double)m->flux.x, exact);
+    cdl_envmap_free(m);
+    free(m);
+    /* light frame with z along world y: world +y sees L1, -y L2 */
+    const cdl_vec3 yup[3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+    m = two_hemispheres(1.0f, 0.25f, 0, yup);
+    cdl_vec3 a = cdl_envmap_eval(m, cdl_v3(0.1f, 0.99f, 0.0f)), b = cdl_envmap_eval(m, cdl_v3(0.0f, -0.99f, 0.1f));
+    CHECK(a.x == 1.0f && b.x == 0.25f, "envmap: rotated frame: up %g, down %g", (double)a.x, (double)b.x);
+    cdl_envmap_free(m);
+    free(m);
+}
+
+/* Mean radiance of the film's pixels whose rays through the centre and the
+ * four corners all hit (hit = 1) or all miss (0) the scene. */
+static double mean_where(const cdl_film *f, const cdl_scene *s, const cdl_camera *cam, int hit, int *count)
+{
+    double sum = 0.0;
+    *count = 0;
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++) {
+            static const float off[5][2] = {{0.5f, 0.5f}, {0, 0}, {1, 0}, {0, 1}, {1, 1}};
+            int all = 1;
+            for (int k = 0; k < 5; k++) {
+                cdl_hit h;
+                cdl_vec3 d = cdl_camera_ray(cam, (float)x + off[k][0], (float)y + off[k][1]);
+                all &= cdl_intersect(s, cam->eye, d, FLT_MAX, &h) == hit;
+            }
+            if (!all)
+                continue;
+            sum += film_pixel(f, x, y, 0);
+            (*count)++;
+        }
+    return *count ? sum / *count : 0.0;
+}
+
+static void plane_under_map(const char *integ, int facing_boundary)
+{
+    cdl_scene s;
+    cdl_error err;
+    die_on(cdl_scene_init(&s, "envplane", &err), &err);
+    const float rho = 0.5f, L1 = 1.0f, L2 = 0.25f;
+    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
+    mat.kd = cdl_v3(rho, rho, rho);
+    uint32_t mid, first;
+    die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
+    /* a square in x = 0 facing +x (the boundary z = 0 cuts its hemisphere
+     * in halves), or in z = 0 facing +z */
+    float px[12] = {0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1}, pz[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    die_on(cdl_scene_add_vertices(&s, 4, facing_boundary ? px : pz, NULL, NULL, &first, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 1, first + 2, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), two_hemispheres(L1, L2, 0, zup), &err), &err);
+    die_on(cdl_scene_commit(&s, &err), &err);
+    cdl_options opt;
+    cdl_options_default(&opt);
+    opt.maxdepth = 4;
+    int W = 16, H = 16;
+    cdl_vec3 eye = facing_boundary ? cdl_v3(3.0f, 0.2f, 0.3f) : cdl_v3(0.2f, 0.3f, 3.0f);
+    cdl_vec3 up = facing_boundary ? cdl_v3(0, 0, 1) : cdl_v3(0, 1, 0);
+    die_on(cdl_camera_init(&opt.camera, eye, cdl_v3(0, 0, 0), up, 30.0f, W, H, &err), &err);
+    cdl_film f;
+    uint32_t spp = 1024 / spp_div > 16 ? 1024 / spp_div : 16;
+    render_film(integ, &s, &opt, W, H, spp, &f);
+    int n;
+    double m = mean_where(&f, &s, &opt.camera, 1, &n);
+    double expect = facing_boundary ? rho * (L1 + L2) / 2.0 : rho * L1;
+    CHECK(n > W * H / 2 && fabs(m / expect - 1.0) < 0.01 * tol_scale,
+          "%s: plane facing %s under two hemispheres: %.4f, expected %.4f (within %.1f %%)", integ,
+          facing_boundary ? "the boundary" : "+z", m, expect, tol_scale);
+    cdl_film_free(&f);
+    cdl_scene_free(&s);
+}
+
+static void sphere_under_constant(const char *integ)
+{
+    cdl_scene s;
+    cdl_error err;
+    die_on(cdl_scene_init(&s, "envsphere", &err), &err);
+    const float a = 0.6f;
+    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
+    mat.kd = cdl_v3(a, a, a);
+    uint32_t mid;
+    die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
+    die_on(cdl_scene_add_sphere(&s, cdl_v3(0, 0, 0), 1.0f, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_infinite_light(&s, cdl_v3(1, 1, 1), &err), &err);
+    die_on(cdl_scene_commit(&s, &err), &err);
+    cdl_options opt;
+    cdl_options_default(&opt);
+    opt.maxdepth = 4;
+    int W = 16, H = 16;
+    die_on(cdl_camera_init(&opt.camera, cdl_v3(0, 0.5f, 4), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 40.0f, W, H, &err),
+           &err);
+    cdl_film f;
+    uint32_t spp = 512 / spp_div > 16 ? 512 / spp_div : 16;
+    render_film(integ, &s, &opt, W, H, spp, &f);
+    int nh, nm;
+    double on = mean_where(&f, &s, &opt.camera, 1, &nh), off = mean_where(&f, &s, &opt.camera, 0, &nm);
+    CHECK(nh > 10 && fabs(on / a - 1.0) < 0.01 * tol_scale,
+          "%s: convex sphere of albedo %.1f under a constant sky: %.4f (within %.1f %%)", integ, a, on, tol_scale);
+    CHECK(nm > 10 && fabs(off - 1.0) < 1e-6, "%s: background %.6f, expected 1", integ, off);
+    cdl_film_free(&f);
+    cdl_scene_free(&s);
+}
+
+/* A pbrt-v3 scene's infinite light with a mapname: the map is read,
+ * scaled by L and turned by the CTM (Rotate -90 1 0 0: the map's +z is the
+ * world's +y), and a missing map is an error naming it. */
+static void pbrt_map(void)
+{
+    cdl_image img;
+    cdl_error err;
+    die_on(cdl_image_alloc(&img, 8, 4, &err), &err);
+    for (int i = 0; i < 8 * 4; i++)
+        for (int c = 0; c < 3; c++)
+            img.rgb[3 * i + c] = i < 16 ? 2.0f : 0.5f;
+    die_on(cdl_image_write("envsky.exr", &img, NULL, 0, 0.0f, &err), &err);
+    cdl_image_free(&img);
+    const char *text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                       "AttributeBegin\nRotate -90 1 0 0\n"
+                       "LightSource \"infinite\" \"string mapname\" \"%s\" \"rgb L\" [3 3 3]\nAttributeEnd\n"
+                       "Shape \"sphere\" \"float radius\" 1\n";
+    for (int missing = 0; missing < 2; missing++) {
+        FILE *f = fopen("envsky.pbrt", "w");
+        fprintf(f, text, missing ? "nosuch.exr" : "envsky.exr");
+        fclose(f);
+        cdl_scene s;
+        cdl_scene_settings set;
+        int rc = cdl_scene_init(&s, "envsky.pbrt", &err);
+        if (!rc)
+            rc = cdl_scene_load(&s, "envsky.pbrt", &set, &err);
+        if (!rc)
+            rc = cdl_scene_commit(&s, &err);
+        if (missing) {
+            CHECK(rc && strstr(err.file, "nosuch.exr"), "pbrt: a missing map is an error naming it (%s)", err.file);
+        } else {
+            CHECK(!rc && s.envmap, "pbrt: infinite light with mapname loaded");
+            if (!rc && s.envmap) {
+                cdl_vec3 up = cdl_envmap_eval(s.envmap, cdl_v3(0, 1, 0)), down = cdl_envmap_eval(s.envmap, cdl_v3(0, -1, 0));
+                CHECK(up.x == 6.0f && down.x == 1.5f, "pbrt: map turned by the CTM and scaled by L: up %g (6), down %g (1.5)",
+                      (double)up.x, (double)down.x);
+            }
+        }
+        cdl_scene_free(&s);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *integ = argc > 1 ? argv[1] : "path";
+    if (getenv("CDL_TEST_SCALE") && atoi(getenv("CDL_TEST_SCALE")) > 1) {
+        spp_div = (uint32_t)atoi(getenv("CDL_TEST_SCALE"));
+        tol_scale = sqrt((double)spp_div);
+    }
+    sampling();
+    pbrt_map();
+    plane_under_map(integ, 1);
+    plane_under_map(integ, 0);
+    sphere_under_constant(integ);
+    printf("%s\n", test_failures ? "FAILED" : "all passed");
+    return test_failures != 0;
+}
