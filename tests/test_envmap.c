@@ -20,6 +20,16 @@
 static double tol_scale = 1.0;
 static uint32_t spp_div = 1;
 
+/* Passes for integ (pm's cost more: a photon map each) and its options. */
+static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
+{
+    if (!strcmp(integ, "pm")) {
+        opt->pm.photons = 5000;
+        spp /= 16;
+    }
+    return spp / spp_div > 16 ? spp / spp_div : 16;
+}
+
 /* Two hemispheres in the light frame: rows above the equator L1, below L2,
  * with a bright spot so that importance sampling has something to find. */
 static cdl_envmap *two_hemispheres(float L1, float L2, int spot, const cdl_vec3 frame[3])
@@ -129,8 +139,7 @@ static void plane_under_map(const char *integ, int facing_boundary)
     cdl_vec3 up = facing_boundary ? cdl_v3(0, 0, 1) : cdl_v3(0, 1, 0);
     die_on(cdl_camera_init(&opt.camera, eye, cdl_v3(0, 0, 0), up, 30.0f, W, H, &err), &err);
     cdl_film f;
-    uint32_t spp = 1024 / spp_div > 16 ? 1024 / spp_div : 16;
-    render_film(integ, &s, &opt, W, H, spp, &f);
+    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 1024), &f);
     int n;
     double m = mean_where(&f, &s, &opt.camera, 1, &n);
     double expect = facing_boundary ? rho * (L1 + L2) / 2.0 : rho * L1;
@@ -161,8 +170,7 @@ static void sphere_under_constant(const char *integ)
     die_on(cdl_camera_init(&opt.camera, cdl_v3(0, 0.5f, 4), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 40.0f, W, H, &err),
            &err);
     cdl_film f;
-    uint32_t spp = 512 / spp_div > 16 ? 512 / spp_div : 16;
-    render_film(integ, &s, &opt, W, H, spp, &f);
+    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 512), &f);
     int nh, nm;
     double on = mean_where(&f, &s, &opt.camera, 1, &nh), off = mean_where(&f, &s, &opt.camera, 0, &nm);
     CHECK(nh > 10 && fabs(on / a - 1.0) < 0.01 * tol_scale,

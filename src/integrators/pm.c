@@ -142,14 +142,7 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     st->t_importons = cdl_time_now() - t0;
     /* pass 0's photons now, so that a budget that cannot be met is an error before rendering */
     uint64_t rays = 0;
-    int rc = trace(st, 0, &rays, err);
-    for (uint32_t i = 0; !rc && i < scene->nlights; i++)
-        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE) {
-            cdl_warn(scene->path, 0, "pm: distant and infinite lights emit no photons yet: their direct "
-                                     "light is sampled, their indirect light is missing");
-            break;
-        }
-    return rc;
+    return trace(st, 0, &rays, err);
 }
 
 int cdl_pm_max_radius(const cdl_scene *s, const cdl_pm_options *o, float *r, cdl_error *err)

@@ -149,8 +149,7 @@ static int run_batch(const trace_ctx *cx, uint64_t first, uint64_t n, int causti
 static int has_emitting_light(const cdl_scene *s)
 {
     for (uint32_t i = 0; i < s->nlights; i++)
-        if (s->lights[i].type != CDL_LIGHT_DISTANT && s->lights[i].type != CDL_LIGHT_INFINITE &&
-            s->light_select.pmf[i] > 0.0f)
+        if (s->light_select.pmf[i] > 0.0f)
             return 1;
     return 0;
 }
@@ -165,8 +164,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
     if (!s->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "the scene has no lights: no photons to trace");
     if (!has_emitting_light(s))
-        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
-                             "photons start only on area, sphere, point and spot lights; this scene has none");
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "no light of the scene emits any power");
     if (!pp->target)
         return cdl_error_set(err, CDL_ERR_USAGE, "--photons", 0, "must be at least 1");
     int specular = 0;

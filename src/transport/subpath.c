@@ -141,8 +141,8 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     cdl_sampler_2d(smp, &u1, &u2);
     cdl_sampler_2d(smp, &u3, &u4);
     cdl_light_emit e;
-    if (l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE)
-        return 0; /* lights at infinity are reached by eye paths and NEE only */
+    /* lights at infinity emit from a disk covering the scene's bounding
+     * sphere, outside it, perpendicular to the direction (cdl_light_sample_le) */
     if (!cdl_light_sample_le(l, u1, u2, u3, u4, &e) || !(e.pdf_pos > 0.0f) || !(e.pdf_dir > 0.0f))
         return 0;
     uint32_t i = push(vs);
@@ -151,7 +151,7 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     vs->wi[i] = cdl_v3(0.0f, 0.0f, 0.0f);
     /* y_0 carries the emitted radiance per unit area density; the
      * direction's distribution is applied at connection (Le_dir). */
-    vs->beta[i] = cdl_scale(l->L, 1.0f / (pmf * e.pdf_pos));
+    vs->beta[i] = cdl_scale(e.Le, 1.0f / (pmf * e.pdf_pos));
     vs->pdf_fwd[i] = pmf * e.pdf_pos;
     vs->parent[i] = -1;
     vs->light[i] = (int32_t)li;
