@@ -45,15 +45,62 @@ static cdl_envmap *two_hemispheres(float L1, float L2, int spot, const cdl_vec3 
             rgb[3 * (5 * w + 9) + c] = 400.0f;
     cdl_envmap *m = malloc(sizeof *m);
     cdl_error err;
-    die_on(cdl_envmap_init(m, w, h, rgb, frame, &err), &err);
+    die_on(cdl_envmap_init(m, w, h, rgb, frame, 0, &err), &err);
     return m;
 }
 
 static const cdl_vec3 zup[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
-static void sampling(void)
+/* A square equal-area map (pbrt-v4): L1 where the texel centre has z > 0,
+ * else L2, and one bright texel. */
+static cdl_envmap *equal_area_map(float L1, float L2, int spot)
 {
-    cdl_envmap *m = two_hemispheres(1.0f, 0.25f, 1, zup);
+    int n = 32;
+    float *rgb = malloc(sizeof(float) * 3 * (size_t)n * (size_t)n);
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++) {
+            cdl_vec3 d = cdl_equal_area_square_to_sphere((x + 0.5f) / n, (y + 0.5f) / n);
+            for (int c = 0; c < 3; c++)
+                rgb[3 * (y * n + x) + c] = d.z > 0.0f ? L1 : L2;
+        }
+    if (spot)
+        for (int c = 0; c < 3; c++)
+            rgb[3 * (7 * n + 20) + c] = 400.0f;
+    cdl_envmap *m = malloc(sizeof *m);
+    cdl_error err;
+    die_on(cdl_envmap_init(m, n, n, rgb, zup, 1, &err), &err);
+    return m;
+}
+
+/* The mapping: square -> sphere -> square is the identity, and uniform
+ * points of the square are uniform on the sphere (E[z] = 0, E[z^2] = 1/3). */
+static void equal_area_mapping(void)
+{
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 3, 0);
+    double worst = 0.0, ez = 0.0, ez2 = 0.0, worst_len = 0.0;
+    enum { N = 200000 };
+    for (int i = 0; i < N; i++) {
+        float u = cdl_rng_float(&rng), v = cdl_rng_float(&rng), u2, v2;
+        cdl_vec3 d = cdl_equal_area_square_to_sphere(u, v);
+        cdl_equal_area_sphere_to_square(d, &u2, &v2);
+        worst = fmax(worst, fmax(fabs(u2 - u), fabs(v2 - v)));
+        worst_len = fmax(worst_len, fabs(cdl_length(d) - 1.0));
+        ez += d.z;
+        ez2 += d.z * d.z;
+    }
+    ez /= N;
+    ez2 /= N;
+    CHECK(worst < 1e-4 && worst_len < 1e-5, "equal-area: square -> sphere -> square within %.2g, |d| - 1 within %.2g",
+          worst, worst_len);
+    CHECK(fabs(ez) < 0.01 && fabs(ez2 - 1.0 / 3.0) < 0.01, "equal-area: uniform on the sphere: E[z] %.4f, E[z^2] %.4f",
+          ez, ez2);
+}
+
+static void sampling(int equal_area)
+{
+    cdl_envmap *m = equal_area ? equal_area_map(1.0f, 0.25f, 1) : two_hemispheres(1.0f, 0.25f, 1, zup);
+    const char *kind = equal_area ? "equal-area" : "equirectangular";
     cdl_rng rng;
     cdl_rng_seed(&rng, 7, 0);
     enum { N = 400000 };
@@ -71,10 +118,19 @@ static void sampling(void)
     }
     est /= N;
     pdf_int /= N;
-    CHECK(worst < 1e-3, "envmap: pdf of the sampled direction equals the sample's pdf (worst %.2g)", worst);
-    CHECK(fabs(pdf_int - 1.0) < 0.02, "envmap: pdf integrates to %.4f over the sphere (1 within 2 %%)", pdf_int);
-    CHECK(fabs(est / m->flux.x - 1.0) < 0.005, "envmap: E[L/pdf] %.5f vs flux %.5f (within 0.5 %%)", est,
+    CHECK(worst < 1e-3, "%s: pdf of the sampled direction equals the sample's pdf (worst %.2g)", kind, worst);
+    CHECK(fabs(pdf_int - 1.0) < 0.02, "%s: pdf integrates to %.4f over the sphere (1 within 2 %%)", kind, pdf_int);
+    CHECK(fabs(est / m->flux.x - 1.0) < 0.005, "%s: E[L/pdf] %.5f vs flux %.5f (within 0.5 %%)", kind, est,
           (double)m->flux.x);
+    if (equal_area) { /* every texel 4 pi / n^2 */
+        double f = 0.0;
+        for (int i = 0; i < m->w * m->h; i++)
+            f += m->rgb[3 * i] * 4.0 * CDL_PI / (m->w * m->h);
+        CHECK(fabs(m->flux.x / f - 1.0) < 1e-4, "equal-area: flux %.5f vs %.5f", (double)m->flux.x, f);
+        cdl_envmap_free(m);
+        free(m);
+        return;
+    }
     /* flux of the two hemispheres plus the spot texel's solid angle */
     double th0 = CDL_PI * 5 / 32, th1 = CDL_PI * 6 / 32;
     double exact = 2.0 * CDL_PI * (1.0 + 0.25) + (400.0 - 1.0) * 2.0 * CDL_PI / 64 * (cos(th0) - cos(th1));
@@ -150,7 +206,7 @@ static void plane_under_map(const char *integ, int facing_boundary)
     cdl_scene_free(&s);
 }
 
-static void sphere_under_constant(const char *integ)
+static void sphere_under_constant(const char *integ, int equal_area)
 {
     cdl_scene s;
     cdl_error err;
@@ -161,7 +217,10 @@ static void sphere_under_constant(const char *integ)
     uint32_t mid;
     die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
     die_on(cdl_scene_add_sphere(&s, cdl_v3(0, 0, 0), 1.0f, mid, -1, 0, &err), &err);
-    die_on(cdl_scene_add_infinite_light(&s, cdl_v3(1, 1, 1), &err), &err);
+    if (equal_area) /* the constant sky as a pbrt-v4 map */
+        die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), equal_area_map(1.0f, 1.0f, 0), &err), &err);
+    else
+        die_on(cdl_scene_add_infinite_light(&s, cdl_v3(1, 1, 1), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
     cdl_options opt;
     cdl_options_default(&opt);
@@ -174,7 +233,8 @@ static void sphere_under_constant(const char *integ)
     int nh, nm;
     double on = mean_where(&f, &s, &opt.camera, 1, &nh), off = mean_where(&f, &s, &opt.camera, 0, &nm);
     CHECK(nh > 10 && fabs(on / a - 1.0) < 0.01 * tol_scale,
-          "%s: convex sphere of albedo %.1f under a constant sky: %.4f (within %.1f %%)", integ, a, on, tol_scale);
+          "%s: convex sphere of albedo %.1f under a constant sky%s: %.4f (within %.1f %%)", integ, a,
+          equal_area ? " (equal-area map)" : "", on, tol_scale);
     CHECK(nm > 10 && fabs(off - 1.0) < 1e-6, "%s: background %.6f, expected 1", integ, off);
     cdl_film_free(&f);
     cdl_scene_free(&s);
@@ -197,10 +257,16 @@ static void pbrt_map(void)
                        "AttributeBegin\nRotate -90 1 0 0\n"
                        "LightSource \"infinite\" \"string mapname\" \"%s\" \"rgb L\" [3 3 3]\nAttributeEnd\n"
                        "Shape \"sphere\" \"float radius\" 1\n";
-    for (int missing = 0; missing < 2; missing++) {
+    for (int missing = 0; missing < 3; missing++) {
         FILE *f = fopen("envsky.pbrt", "w");
         fprintf(f, text, missing ? "nosuch.exr" : "envsky.exr");
         fclose(f);
+        if (missing == 2) { /* pbrt-v4's filename: equal-area, so square */
+            f = fopen("envsky.pbrt", "w");
+            fprintf(f, "WorldBegin\nLightSource \"infinite\" \"string filename\" \"envsky.exr\"\n"
+                       "Shape \"sphere\" \"float radius\" 1\n");
+            fclose(f);
+        }
         cdl_scene s;
         cdl_scene_settings set;
         int rc = cdl_scene_init(&s, "envsky.pbrt", &err);
@@ -208,7 +274,10 @@ static void pbrt_map(void)
             rc = cdl_scene_load(&s, "envsky.pbrt", &set, &err);
         if (!rc)
             rc = cdl_scene_commit(&s, &err);
-        if (missing) {
+        if (missing == 2) {
+            CHECK(rc && strstr(err.file, "envsky.exr") && strstr(err.msg, "square"),
+                  "pbrt-v4: an 8x4 equal-area map is an error: %s: %s", err.file, err.msg);
+        } else if (missing) {
             CHECK(rc && strstr(err.file, "nosuch.exr"), "pbrt: a missing map is an error naming it (%s)", err.file);
         } else {
             CHECK(!rc && s.envmap, "pbrt: infinite light with mapname loaded");
@@ -229,11 +298,14 @@ int main(int argc, char **argv)
         spp_div = (uint32_t)atoi(getenv("CDL_TEST_SCALE"));
         tol_scale = sqrt((double)spp_div);
     }
-    sampling();
+    sampling(0);
+    equal_area_mapping();
+    sampling(1);
     pbrt_map();
     plane_under_map(integ, 1);
     plane_under_map(integ, 0);
-    sphere_under_constant(integ);
+    sphere_under_constant(integ, 0);
+    sphere_under_constant(integ, 1);
     printf("%s\n", test_failures ? "FAILED" : "all passed");
     return test_failures != 0;
 }

@@ -53,11 +53,48 @@ static int find(const float *cdf, int n, float u)
     return lo;
 }
 
-int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 frame[3], cdl_error *err)
+cdl_vec3 cdl_equal_area_square_to_sphere(float pu, float pv)
+{
+    float u = 2.0f * pu - 1.0f, v = 2.0f * pv - 1.0f, up = fabsf(u), vp = fabsf(v);
+    float sd = 1.0f - (up + vp), d = fabsf(sd), r = 1.0f - d;
+    float phi = (r == 0.0f ? 1.0f : (vp - up) / r + 1.0f) * 0.25f * CDL_PI;
+    float z = copysignf(1.0f - r * r, sd);
+    float cp = copysignf(cosf(phi), u), sp = copysignf(sinf(phi), v);
+    float s = r * sqrtf(fmaxf(0.0f, 2.0f - r * r));
+    return cdl_v3(cp * s, sp * s, z);
+}
+
+void cdl_equal_area_sphere_to_square(cdl_vec3 d, float *pu, float *pv)
+{
+    float x = fabsf(d.x), y = fabsf(d.y), z = fabsf(d.z);
+    float r = sqrtf(fmaxf(0.0f, 1.0f - z));
+    float a = fmaxf(x, y), b = fminf(x, y);
+    b = a == 0.0f ? 0.0f : b / a;
+    float phi = atanf(b) * 2.0f * CDL_INV_PI;
+    if (x < y)
+        phi = 1.0f - phi;
+    float v = phi * r, u = r - v;
+    if (d.z < 0.0f) {
+        float t = u;
+        u = 1.0f - v;
+        v = 1.0f - t;
+    }
+    u = copysignf(u, d.x);
+    v = copysignf(v, d.y);
+    *pu = 0.5f * (u + 1.0f);
+    *pv = 0.5f * (v + 1.0f);
+}
+
+int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 frame[3], int equal_area,
+                    cdl_error *err)
 {
     memset(m, 0, sizeof *m);
+    if (equal_area && w != h)
+        return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "an equal-area environment map must be square, not %dx%d",
+                             w, h);
     m->w = w;
     m->h = h;
+    m->equal_area = equal_area;
     m->rgb = rgb;
     /* a right-handed orthonormal frame from the transform's axes */
     m->ez = cdl_normalize(frame[2]);
@@ -81,9 +118,9 @@ int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 fram
     cdl_vec3 flux = cdl_v3(0.0f, 0.0f, 0.0f);
     for (int y = 0; y < h; y++) {
         float th0 = CDL_PI * (float)y / (float)h, th1 = CDL_PI * (float)(y + 1) / (float)h;
-        float sin_c = sinf(0.5f * (th0 + th1));
+        float sin_c = equal_area ? 1.0f : sinf(0.5f * (th0 + th1));
         /* the solid angle of a texel of this row */
-        float dw = 2.0f * CDL_PI / (float)w * (cosf(th0) - cosf(th1));
+        float dw = equal_area ? 4.0f * CDL_PI / (float)n : 2.0f * CDL_PI / (float)w * (cosf(th0) - cosf(th1));
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             cdl_vec3 L = cdl_v3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
@@ -100,7 +137,8 @@ int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 fram
     return 0;
 }
 
-int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_vec3 frame[3], cdl_error *err)
+int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_vec3 frame[3], int equal_area,
+                    cdl_error *err)
 {
     memset(m, 0, sizeof *m);
     cdl_image img = {0};
@@ -132,7 +170,7 @@ int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_v
         }
         img.rgb[i] = v;
     }
-    rc = cdl_envmap_init(m, img.width, img.height, img.rgb, frame, err);
+    rc = cdl_envmap_init(m, img.width, img.height, img.rgb, frame, equal_area, err);
     if (rc) {
         cdl_image_free(&img);
         if (err && !err->file[0])
@@ -141,10 +179,14 @@ int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_v
     return rc;
 }
 
-/* (u, v) in [0,1)^2 of world direction w, and sin(theta) there. */
+/* (u, v) in [0,1)^2 of world direction w. */
 static void to_uv(const cdl_envmap *m, cdl_vec3 w, float *u, float *v)
 {
     float x = cdl_dot(w, m->ex), y = cdl_dot(w, m->ey), z = cdl_dot(w, m->ez);
+    if (m->equal_area) {
+        cdl_equal_area_sphere_to_square(cdl_v3(x, y, z), u, v);
+        return;
+    }
     float th = atan2f(sqrtf(x * x + y * y), z); /* acos(z) loses the poles to rounding */
     float ph = atan2f(y, x);
     if (ph < 0.0f)
@@ -173,6 +215,8 @@ float cdl_envmap_pdf(const cdl_envmap *m, cdl_vec3 w)
 {
     float u, v;
     to_uv(m, w, &u, &v);
+    if (m->equal_area) /* the square's density over the sphere's 4 pi */
+        return m->mean > 0.0f ? m->func[texel(m, u, v)] / m->mean / (4.0f * CDL_PI) : 0.0f;
     float s = sinf(v * CDL_PI);
     if (!(m->mean > 0.0f) || !(s > 0.0f))
         return 0.0f;
@@ -194,14 +238,18 @@ cdl_vec3 cdl_envmap_sample(const cdl_envmap *m, float u1, float u2, cdl_vec3 *w,
      * would put the direction into the neighbour */
     float u = ((float)x + 1e-4f + 0.9998f * clampf(fx, 0.0f, 1.0f)) / (float)m->w;
     float v = ((float)y + 1e-4f + 0.9998f * clampf(fy, 0.0f, 1.0f)) / (float)m->h;
-    float th = v * CDL_PI, ph = u * 2.0f * CDL_PI;
-    float st = sinf(th);
-    if (!(st > 0.0f))
-        return cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_vec3 d = cdl_add(cdl_add(cdl_scale(m->ex, st * cosf(ph)), cdl_scale(m->ey, st * sinf(ph))),
-                         cdl_scale(m->ez, cosf(th)));
-    *w = d;
     size_t i = (size_t)y * (size_t)m->w + (size_t)x;
-    *pdf = m->func[i] / m->mean / (2.0f * CDL_PI * CDL_PI * st);
+    cdl_vec3 l;
+    if (m->equal_area) {
+        l = cdl_equal_area_square_to_sphere(u, v);
+        *pdf = m->func[i] / m->mean / (4.0f * CDL_PI);
+    } else {
+        float th = v * CDL_PI, ph = u * 2.0f * CDL_PI, st = sinf(th);
+        if (!(st > 0.0f))
+            return cdl_v3(0.0f, 0.0f, 0.0f);
+        l = cdl_v3(st * cosf(ph), st * sinf(ph), cosf(th));
+        *pdf = m->func[i] / m->mean / (2.0f * CDL_PI * CDL_PI * st);
+    }
+    *w = cdl_add(cdl_add(cdl_scale(m->ex, l.x), cdl_scale(m->ey, l.y)), cdl_scale(m->ez, l.z));
     return cdl_v3(m->rgb[3 * i], m->rgb[3 * i + 1], m->rgb[3 * i + 2]);
 }

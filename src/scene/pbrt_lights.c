@@ -87,14 +87,18 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         if ((rc = cdl_pbrt_get_string(ps, "mapname", NULL, &map, err)) ||
             (rc = cdl_pbrt_get_string(ps, "filename", NULL, &v4map, err)))
             return rc;
-        if (v4map) /* pbrt-v4: an equal-area octahedral square map */
-            cdl_pbrt_warn(c, c->line, "pbrt-v4 environment map \"%s\" (equal-area) is not supported yet: the "
-                          "constant L is used", v4map);
         cdl_pbrt_find(ps, "samples");
         cdl_pbrt_find(ps, "nsamples");
+        if (map && v4map)
+            return cdl_pbrt_error(c, c->line, "infinite light: give \"mapname\" (pbrt-v3) or \"filename\" (pbrt-v4), "
+                                              "not both");
+        int equal_area = !map && v4map;
+        if (equal_area)
+            map = v4map;
         if (!map)
             return cdl_pbrt_scene_rc(c, cdl_scene_add_infinite_light(c->s, v, err));
-        /* pbrt-v3: equirectangular in the light's frame (the CTM), L scales it */
+        /* in the light's frame (the CTM), scaled by L and scale: pbrt-v3's
+         * mapname equirectangular, pbrt-v4's filename equal-area */
         char path[1024];
         cdl_pbrt_resolve(c, map, path, sizeof path);
         cdl_vec3 frame[3];
@@ -106,7 +110,7 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         cdl_envmap *em = malloc(sizeof *em);
         if (!em)
             return cdl_pbrt_error(c, c->line, "out of memory");
-        if ((rc = cdl_envmap_load(em, path, v, frame, err))) {
+        if ((rc = cdl_envmap_load(em, path, v, frame, equal_area, err))) {
             free(em);
             return rc;
         }
