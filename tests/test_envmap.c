@@ -27,6 +27,10 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
         opt->pm.photons = 5000;
         spp /= 16;
     }
+    if (!strcmp(integ, "rigi") || !strcmp(integ, "ir")) {
+        opt->light_paths = 16;
+        spp /= 4;
+    }
     return spp / spp_div > 16 ? spp / spp_div : 16;
 }
 
@@ -206,6 +210,42 @@ static void plane_under_map(const char *integ, int facing_boundary)
     cdl_scene_free(&s);
 }
 
+/* A Lambertian square facing +z under a distant light of radiance E at
+ * angle theta: rho E cos(theta) / pi. */
+static void plane_under_distant(const char *integ)
+{
+    cdl_scene s;
+    cdl_error err;
+    die_on(cdl_scene_init(&s, "distantplane", &err), &err);
+    const float rho = 0.5f, E = 2.0f;
+    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
+    mat.kd = cdl_v3(rho, rho, rho);
+    uint32_t mid, first;
+    die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
+    float pz[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    die_on(cdl_scene_add_vertices(&s, 4, pz, NULL, NULL, &first, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 1, first + 2, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
+    cdl_vec3 dir = cdl_normalize(cdl_v3(-0.6f, 0.2f, -1.0f)); /* the way the light travels */
+    die_on(cdl_scene_add_distant_light(&s, dir, cdl_v3(E, E, E), &err), &err);
+    die_on(cdl_scene_commit(&s, &err), &err);
+    cdl_options opt;
+    cdl_options_default(&opt);
+    opt.maxdepth = 4;
+    int W = 16, H = 16;
+    die_on(cdl_camera_init(&opt.camera, cdl_v3(0.2f, 0.3f, 3.0f), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 30.0f, W, H, &err),
+           &err);
+    cdl_film f;
+    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 64), &f);
+    int n;
+    double m = mean_where(&f, &s, &opt.camera, 1, &n), expect = rho * E * -dir.z / CDL_PI;
+    CHECK(n > W * H / 2 && fabs(m / expect - 1.0) < 0.01 * tol_scale,
+          "%s: plane under a distant light: %.5f, expected rho E cos / pi = %.5f (within %.1f %%)", integ, m, expect,
+          tol_scale);
+    cdl_film_free(&f);
+    cdl_scene_free(&s);
+}
+
 static void sphere_under_constant(const char *integ, int equal_area)
 {
     cdl_scene s;
@@ -304,6 +344,7 @@ int main(int argc, char **argv)
     pbrt_map();
     plane_under_map(integ, 1);
     plane_under_map(integ, 0);
+    plane_under_distant(integ);
     sphere_under_constant(integ, 0);
     sphere_under_constant(integ, 1);
     printf("%s\n", test_failures ? "FAILED" : "all passed");

@@ -19,7 +19,14 @@
  * from all eye vertices of a 16 x 16 tile (Embree ray stream).
  *
  * ir: the first diffuse eye vertex connects to every point light of its
- * set with G clamped at --clamp (Fig. 2a): biased, darker in corners. */
+ * set with G clamped at --clamp (Fig. 2a): biased, darker in corners.
+ *
+ * Lights at infinity (distant, infinite): their light paths start on the
+ * disk covering the scene, which is no point light; their vertices from
+ * the first hit on are. Their direct light comes by light sampling at every
+ * eye vertex instead (G to a light at infinity is 0 < t: the light-sampling
+ * stratum of rigi, whole), and eye rays that leave the scene see them only
+ * from the camera or after specular bounces, as emitters. */
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,8 +43,14 @@ typedef struct rigi_state {
     int clamped;  /* ir */
     int clip;     /* §4.1 clipping is only safe without specular surfaces */
     int per_sample; /* an independent light path per pixel sample, no pool */
+    int at_infinity; /* the scene has distant or infinite lights */
     cdl_light_pool pool;
 } rigi_state;
+
+static int at_infinity(const cdl_light *l)
+{
+    return l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
+}
 
 static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, int clamped,
                    cdl_error *err)
@@ -58,11 +71,9 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
         st->t = opt->clamp > 0.0f ? opt->clamp : cdl_default_threshold(scene, opt);
     else
         st->t = cdl_default_threshold(scene, opt);
+    st->at_infinity = 0;
     for (uint32_t i = 0; i < scene->nlights; i++)
-        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
-            return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
-                                 "%s does not support distant or infinite lights yet",
-                                 clamped ? "ir" : "rigi");
+        st->at_infinity |= at_infinity(&scene->lights[i]);
     st->per_sample = opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE;
     if (st->per_sample)
         return opt->interleave > 1 ? cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0,
@@ -117,6 +128,31 @@ typedef struct tile_work {
     uint32_t cap_bundle;
 } tile_work;
 
+/* Direct light from every light at infinity at an eye vertex: one light
+ * sample each (the maps importance-sampled), one shadow ray. */
+static cdl_vec3 light_at_infinity(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
+                                  cdl_sampler *smp, uint64_t *rays)
+{
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    for (uint32_t i = 0; i < s->nlights; i++) {
+        const cdl_light *l = &s->lights[i];
+        if (!at_infinity(l))
+            continue;
+        float u1, u2;
+        cdl_sampler_2d(smp, &u1, &u2);
+        cdl_light_sample ls;
+        if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls) || !(ls.pdf > 0.0f))
+            continue;
+        cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
+        if (cdl_is_black(f))
+            continue;
+        (*rays)++;
+        if (cdl_light_sample_visible(s, l, sf->p, sf->ng, &ls))
+            L = cdl_add(L, cdl_scale(cdl_mul(f, ls.Li), fabsf(cdl_dot(ls.wi, b->frame.n)) / ls.pdf));
+    }
+    return L;
+}
+
 static int grow_cand(tile_work *w)
 {
     uint32_t cap = w->cap_cand ? 2 * w->cap_cand : 4096;
@@ -143,8 +179,18 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
     for (int depth = 0;; depth++) {
         cdl_hit h;
         (*rays)++;
-        if (!cdl_intersect(s, o, d, tmax, &h))
-            return L; /* beyond the clip radius: G < t, the point lights cover it */
+        if (!cdl_intersect(s, o, d, tmax, &h)) {
+            /* beyond the clip radius: G < t, the point lights cover it; a
+             * ray that leaves the scene from the camera or a specular
+             * bounce sees the lights at infinity (no connection there) */
+            if (prev_delta && tmax == FLT_MAX && s->env_light >= 0) {
+                cdl_vec3 e = cdl_mul(beta, cdl_light_env_Le(&s->lights[s->env_light], d));
+                L = cdl_add(L, e);
+                stratum = depth < CDL_STRATA ? depth : CDL_STRATA - 1;
+                w->strata[pixel][stratum] = cdl_add(w->strata[pixel][stratum], e);
+            }
+            return L;
+        }
         cdl_surface sf;
         cdl_surface_at(s, &h, &sf);
         cdl_bsdf b;
@@ -182,6 +228,11 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
             if (!w->eye_pixel)
                 return L;
             w->eye_pixel[i] = pixel;
+            if (st->at_infinity && depth < st->opt.maxdepth) {
+                cdl_vec3 e = cdl_mul(beta, light_at_infinity(s, &sf, &b, wo, smp, rays));
+                L = cdl_add(L, e);
+                w->strata[pixel][stratum] = cdl_add(w->strata[pixel][stratum], e);
+            }
             if (st->clamped)
                 return L; /* ir: the point lights carry all further bounces */
         }
@@ -232,6 +283,8 @@ static void connect_set(const rigi_state *st, const cdl_light_pool *lp, tile_wor
             uint32_t y = base + j;
             if (lv->flags[y] & CDL_V_DELTA)
                 continue; /* specular light vertices are not point lights */
+            if (j == 0 && at_infinity(&st->scene->lights[lv->light[y]]))
+                continue; /* light sampling covers lights at infinity */
             int delta_pos = (lv->flags[y] & CDL_V_DELTA_LIGHT) != 0;
             cdl_vec3 yp = lv->p[y], yn = cdl_vertex_normal(lv, y);
             cdl_vec3 yfrom = j > 0 ? lv->p[y - 1] : yp;
