@@ -167,7 +167,7 @@ static void lights_at_infinity(void)
         else
             die_on(cdl_scene_add_distant_light(&s, cdl_v3(0, -1, 0), L, &err), &err);
         die_on(cdl_scene_commit(&s, &err), &err);
-        cdl_walk walk = {1, 3};
+        cdl_walk walk = {1, 3, 0};
         uint32_t target = 100000 / count_div;
         cdl_photon_params pp = params(target);
         cdl_photon_map g, c;
@@ -201,7 +201,7 @@ static void point_light_square(void)
     add_floor(&s, X0, X1, Z0, Z1, 0.5f);
     die_on(cdl_scene_add_point_light(&s, lp, cdl_v3(I, 2 * I, 3 * I), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
-    cdl_walk walk = {8, 3};
+    cdl_walk walk = {8, 3, 0};
     uint32_t target = 200000 / count_div;
     cdl_photon_params pp = params(target);
     cdl_photon_map g, c;
@@ -299,7 +299,7 @@ static void spot_light(void)
                                     10.0f, &err),
            &err);
     die_on(cdl_scene_commit(&s, &err), &err);
-    cdl_walk walk = {8, 3};
+    cdl_walk walk = {8, 3, 0};
     uint32_t target = 200000 / count_div;
     cdl_photon_params pp = params(target);
     cdl_photon_map g, c;
@@ -404,7 +404,7 @@ static void furnace(void)
     build_sphere(&s, 64, 128, a, &area);
     die_on(cdl_scene_add_point_light(&s, cdl_v3(0.01f, 0.02f, -0.015f), cdl_v3(I, I, I), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
-    cdl_walk walk = {64, 3};
+    cdl_walk walk = {64, 3, 0};
     uint32_t target = 300000 / count_div;
     cdl_photon_params pp = params(target);
     cdl_photon_map g, c;
@@ -484,7 +484,7 @@ static void room_determinism(void)
     cdl_scene s;
     cdl_error err;
     build_room(&s);
-    cdl_walk walk = {16, 3};
+    cdl_walk walk = {16, 3, 0};
     uint32_t target = 40000 / count_div;
     int nthreads = omp_get_max_threads();
     double gflux[3], cflux[3], gsd2[3], csd2[3]; /* green flux of both maps, relative variance */
@@ -565,7 +565,7 @@ static void importance(void)
     die_on(cdl_camera_init(&cam, cdl_v3(-1.0f, 3.0f, 0.0f), cdl_v3(-1.0f, 0.0f, 0.0f), cdl_v3(0.0f, 0.0f, -1.0f), 30.0f,
                            64, 64, &err),
            &err);
-    cdl_walk walk = {8, 3};
+    cdl_walk walk = {8, 3, 0};
     cdl_importance imp;
     die_on(cdl_importance_build(&imp, &s, &cam, &walk, 32768, 1024, 0.1f, CDL_SAMPLER_SOBOL, 1, &err), &err);
     const double omega = rect_sa(-2, 2, -2, 2, 0, h, 0), P = I * omega;
@@ -647,7 +647,7 @@ static void expect_error(const char *what, int rc, const cdl_error *err, const c
 static void budgets(void)
 {
     cdl_error err;
-    cdl_walk walk = {8, 3};
+    cdl_walk walk = {8, 3, 0};
     cdl_photon_map g, c;
     cdl_pmap_init(&g);
     cdl_pmap_init(&c);

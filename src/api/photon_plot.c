@@ -113,7 +113,7 @@ int cdl_photon_plot(cdl_scene *scene, const cdl_settings *settings, int size, cd
     cdl_pmap_init(&g);
     cdl_pmap_init(&c);
     view pv = {0}, iv = {0};
-    cdl_walk walk = {opt.maxdepth, opt.rr_depth};
+    cdl_walk walk = {opt.maxdepth, opt.rr_depth, 0};
     float r = 0.0f;
     cdl_photon_params pp = {0};
     rc = cdl_pm_max_radius(scene, &opt.pm, &r, err);

@@ -40,12 +40,16 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     st->walk.maxdepth = opt->maxdepth;
     st->walk.rr_depth = opt->rr_depth;
     st->threshold = cdl_default_threshold(scene, opt);
-    for (uint32_t i = 0; i < scene->nlights; i++)
-        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
-            return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
-                                 "bdpt does not support distant or infinite lights yet");
     if (st->opt.light_paths == CDL_LIGHT_PATHS_PER_SAMPLE)
         st->opt.light_paths = 0; /* bdpt's default */
+    /* lights at infinity: their s = 1 strategy is light sampling, which
+     * shared light paths do not resample */
+    for (uint32_t i = 0; st->opt.light_paths && i < scene->nlights; i++)
+        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
+            return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
+                                 "bdpt with shared light paths does not support distant or infinite lights yet "
+                                 "(--light-paths sample does)");
+    st->walk.env_vertex = 1;
     if (st->opt.light_paths && cdl_light_pool_init(&st->pool, st->opt.light_paths, opt->interleave,
                                                    opt->maxdepth, err))
         return err->code;
@@ -72,16 +76,24 @@ static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *c
     cdl_sampler_2d(smp, &us, &ua);
     cdl_sampler_2d(smp, &u1, &u2);
     uint32_t pt = t - 1;
-    if (evs->flags[pt] & CDL_V_DELTA)
+    if (evs->flags[pt] & (CDL_V_DELTA | CDL_V_INFINITE))
         return zero;
     uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
     const cdl_light *l = &s->lights[li];
     cdl_light_sample ls;
     if (!cdl_light_sample_li(l, evs->p[pt], u1, u2, &ls))
         return zero;
-    cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f), Le = l->L;
     float pdf_area = ls.pdf; /* delta lights: 1 */
-    if (l->type == CDL_LIGHT_TRIANGLE || l->type == CDL_LIGHT_SPHERE) {
+    int inf = l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
+    if (inf) {
+        /* a point 2 R away along the sampled direction: the 1 / d^2 of the
+         * connection's G cancels in the throughput */
+        cdl_vec3 dd = cdl_sub(ls.p, evs->p[pt]);
+        float d2 = cdl_dot(dd, dd);
+        pdf_area = ls.pdf / d2;
+        Le = ls.Li;
+    } else if (l->type == CDL_LIGHT_TRIANGLE || l->type == CDL_LIGHT_SPHERE) {
         n = l->type == CDL_LIGHT_TRIANGLE ? l->n : cdl_normalize(cdl_sub(ls.p, l->p));
         if (l->type == CDL_LIGHT_SPHERE && l->inward)
             n = cdl_neg(n);
@@ -95,13 +107,13 @@ static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *c
     tmp->p[0] = ls.p;
     tmp->ng[0] = tmp->ns[0] = n;
     tmp->wi[0] = zero;
-    tmp->beta[0] = cdl_scale(l->L, 1.0f / (pmf * pdf_area));
-    tmp->pdf_fwd[0] = cdl_light_pdf_origin(s, (int32_t)li);
+    tmp->beta[0] = cdl_scale(Le, 1.0f / (pmf * pdf_area));
+    tmp->pdf_fwd[0] = inf ? cdl_light_pdf_infinite(s, ls.wi) : cdl_light_pdf_origin(s, (int32_t)li);
     tmp->pdf_rev[0] = 0.0f;
     tmp->parent[0] = -1;
     tmp->light[0] = (int32_t)li;
     tmp->depth[0] = 0;
-    tmp->flags[0] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0);
+    tmp->flags[0] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0) | (inf ? CDL_V_INFINITE : 0);
     return cdl_connect(cx, evs, t, tmp, 0, 1, rays);
 }
 

@@ -21,8 +21,8 @@ float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
     case CDL_LIGHT_TRIANGLE:
     case CDL_LIGHT_SPHERE:
         return cdl_is_black(cdl_light_Le(l, n, w)) ? 0.0f : 1.0f;
-    default:
-        return 0.0f;
+    default: /* at infinity: the sampled radiance is in the vertex's throughput */
+        return 1.0f;
     }
 }
 
@@ -94,6 +94,8 @@ float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint
     float len = cdl_length(w);
     if (!(len > 0.0f))
         return 0.0f;
+    if (vs->flags[i] & CDL_V_INFINITE) /* a light at infinity reaches `to` from its disk */
+        return cdl_light_pdf_disk(cx->scene, cdl_scale(w, 1.0f / len), nt);
     return cdl_pdf_to_area(cdl_vertex_pdf_sa(cx, vs, i, from, cdl_scale(w, 1.0f / len)), p, to, nt);
 }
 
@@ -175,7 +177,9 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
     if (!(evs->flags[i] & CDL_V_EMITTER))
         return zero;
     const cdl_light *l = &cx->scene->lights[evs->light[i]];
-    cdl_vec3 Le = cdl_light_Le(l, evs->ng[i], evs->wi[i]);
+    int inf = (evs->flags[i] & CDL_V_INFINITE) != 0;
+    cdl_vec3 d = cdl_neg(evs->wi[i]); /* at infinity: towards the sky */
+    cdl_vec3 Le = inf ? cdl_light_env_Le(l, d) : cdl_light_Le(l, evs->ng[i], evs->wi[i]);
     if (cdl_is_black(Le))
         return zero;
     cdl_vec3 c = cdl_mul(evs->beta[i], Le);
@@ -185,10 +189,16 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
     if (t > MAX_PATH)
         return zero;
     fill_records(v, evs, t, NULL, 0, 0, cx->mis == CDL_MIS_STRATIFIED);
-    v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
-    v[i].pdf_s1 = resample_pdf(cx, evs->light[i], evs->p[i], evs->ng[i], evs->p[i - 1]);
-    v[i - 1].pdf_light = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[i], evs->wi[i]), evs->p[i],
-                                         evs->p[i - 1], cdl_vertex_normal(evs, i - 1));
+    if (inf) { /* pbrt-v3's densities for a light at infinity */
+        v[i].pdf_light = cdl_light_pdf_infinite(cx->scene, d);
+        v[i - 1].pdf_light = cdl_light_pdf_disk(cx->scene, d, cdl_vertex_normal(evs, i - 1));
+        v[i - 1].g_next = 0.0f; /* G to infinity */
+    } else {
+        v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
+        v[i].pdf_s1 = resample_pdf(cx, evs->light[i], evs->p[i], evs->ng[i], evs->p[i - 1]);
+        v[i - 1].pdf_light = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[i], evs->wi[i]), evs->p[i],
+                                             evs->p[i - 1], cdl_vertex_normal(evs, i - 1));
+    }
     v[i].delta = 0;
     return cdl_scale(c, cdl_mis_weight(cx->mis, v, 0, (int)t, 0, cx->counts, cx->threshold));
 }
@@ -198,7 +208,7 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
 {
     cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
     uint32_t pt = t - 1, qs = l0 + s - 1;
-    if ((evs->flags[pt] & CDL_V_DELTA) || (lvs->flags[qs] & CDL_V_DELTA) || s + t > MAX_PATH)
+    if ((evs->flags[pt] & (CDL_V_DELTA | CDL_V_INFINITE)) || (lvs->flags[qs] & CDL_V_DELTA) || s + t > MAX_PATH)
         return zero;
     cdl_vec3 pp = evs->p[pt], qp = lvs->p[qs];
     cdl_vec3 pm = evs->p[pt - 1];
@@ -223,8 +233,15 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     v[pt].pdf_light = cdl_vertex_pdf(cx, lvs, qs, qm, pp, np);
     v[pt - 1].pdf_light = cdl_vertex_pdf(cx, evs, pt, qp, pm, cdl_vertex_normal(evs, pt - 1));
     v[t].pdf_eye = cdl_vertex_pdf(cx, evs, pt, pm, qp, nq);
-    if (s >= 2)
+    if (lvs->flags[qs] & CDL_V_INFINITE) { /* densities of directions there */
+        v[t].pdf_eye = cdl_vertex_pdf_sa(cx, evs, pt, pm, cdl_normalize(cdl_sub(qp, pp)));
+        v[pt].g_next = 0.0f;
+    }
+    if (s >= 2) {
         v[t + 1].pdf_eye = cdl_vertex_pdf(cx, lvs, qs, pp, qm, cdl_vertex_normal(lvs, qs - 1));
+        if (lvs->flags[qs - 1] & CDL_V_INFINITE)
+            v[t + 1].pdf_eye = cdl_vertex_pdf_sa(cx, lvs, qs, pp, cdl_normalize(cdl_sub(qm, qp)));
+    }
     v[pt].delta = v[t].delta = 0;
     v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
                                        s >= 2 ? lvs->p[l0 + 1] : pp);
@@ -275,7 +292,9 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     v[s].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
     cdl_vec3 nq = cdl_vertex_normal(lvs, qs);
     v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
-    v[2].pdf_eye = cdl_vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
+    v[2].pdf_eye = (lvs->flags[qs - 1] & CDL_V_INFINITE)
+                       ? cdl_vertex_pdf_sa(cx, lvs, qs, cam->eye, cdl_normalize(cdl_sub(qm, qp)))
+                       : cdl_vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
     v[1].delta = 0;
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
     float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, cx->counts, cx->threshold);

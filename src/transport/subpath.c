@@ -30,6 +30,24 @@ float cdl_light_pdf_origin(const cdl_scene *s, int32_t light)
     return l->area > 0.0f ? pmf / l->area : 0.0f;
 }
 
+float cdl_light_pdf_infinite(const cdl_scene *s, cdl_vec3 w)
+{
+    float pdf = 0.0f;
+    for (uint32_t i = 0; i < s->nlights; i++)
+        if (s->lights[i].type == CDL_LIGHT_INFINITE)
+            pdf += s->light_select.pmf[i] * cdl_light_pdf_li(&s->lights[i], cdl_v3(0, 0, 0), w, FLT_MAX);
+    return pdf;
+}
+
+float cdl_light_pdf_disk(const cdl_scene *s, cdl_vec3 w, cdl_vec3 n)
+{
+    float r = 0.5f * cdl_length(cdl_sub(s->bmax, s->bmin));
+    if (!(r > 0.0f))
+        r = 1.0f;
+    float pdf = 1.0f / (CDL_PI * r * r);
+    return cdl_is_black(n) ? pdf : pdf * fabsf(cdl_dot(n, w));
+}
+
 static uint32_t push(cdl_vertex_store *vs)
 {
     uint32_t i = vs->n++;
@@ -58,6 +76,20 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
                 esc->beta = beta;
                 esc->pdf_dir = pdf_dir;
             }
+            if (!adjoint && walk->env_vertex && s->env_light >= 0) {
+                /* the vertex at infinity where the eye path met the sky:
+                 * its forward density stays in solid angle */
+                uint32_t i = push(vs);
+                vs->p[i] = cdl_add(o, d);
+                vs->ng[i] = vs->ns[i] = cdl_neg(d);
+                vs->wi[i] = cdl_neg(d);
+                vs->beta[i] = beta;
+                vs->pdf_fwd[i] = pdf_dir;
+                vs->parent[i] = (int32_t)prev;
+                vs->depth[i] = (uint16_t)depth;
+                vs->light[i] = s->env_light;
+                vs->flags[i] = CDL_V_EMITTER | CDL_V_INFINITE;
+            }
             return;
         }
         cdl_surface sf;
@@ -68,7 +100,9 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
         vs->ns[i] = cdl_dot(sf.ns, sf.ng) < 0.0f ? cdl_neg(sf.ns) : sf.ns;
         vs->wi[i] = cdl_neg(d);
         vs->beta[i] = beta;
-        vs->pdf_fwd[i] = cdl_pdf_to_area(pdf_dir, vs->p[prev], sf.p, sf.ng);
+        /* after a light at infinity: the disk's density, projected */
+        vs->pdf_fwd[i] = (vs->flags[prev] & CDL_V_INFINITE) ? cdl_light_pdf_disk(s, d, sf.ng)
+                                                             : cdl_pdf_to_area(pdf_dir, vs->p[prev], sf.p, sf.ng);
         vs->u[i] = sf.u;
         vs->v[i] = sf.v;
         vs->parent[i] = (int32_t)prev;
@@ -102,10 +136,12 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
             w = cdl_scale(w, den > 0.0f ? num / den : 0.0f);
         }
         beta = cdl_mul(beta, w);
-        vs->pdf_rev[prev] = cdl_pdf_to_area(pdf_rev_sa, sf.p, vs->p[prev],
-                                            (vs->flags[prev] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
-                                                ? cdl_v3(0.0f, 0.0f, 0.0f)
-                                                : vs->ng[prev]);
+        vs->pdf_rev[prev] = (vs->flags[prev] & CDL_V_INFINITE)
+                                ? pdf_rev_sa /* solid angle, as its forward density */
+                                : cdl_pdf_to_area(pdf_rev_sa, sf.p, vs->p[prev],
+                                                  (vs->flags[prev] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
+                                                      ? cdl_v3(0.0f, 0.0f, 0.0f)
+                                                      : vs->ng[prev]);
         if (depth >= walk->rr_depth) {
             float q = cdl_minf(1.0f, cdl_max3(w));
             if (cdl_sampler_cheap(smp) >= q)
@@ -157,6 +193,12 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     vs->light[i] = (int32_t)li;
     vs->depth[i] = 0;
     vs->flags[i] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0);
+    if (l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE) {
+        /* pbrt-v3: y_0's density is that of its direction, y_1's that of
+         * the disk point (set in random_walk) */
+        vs->flags[i] |= CDL_V_INFINITE;
+        vs->pdf_fwd[i] = cdl_light_pdf_infinite(s, cdl_neg(e.d));
+    }
     float cos = cdl_is_black(e.n) ? 1.0f : fabsf(cdl_dot(e.n, e.d));
     cdl_vec3 beta = cdl_scale(e.Le, cos / (pmf * e.pdf_pos * e.pdf_dir));
     cdl_vec3 o = cdl_is_black(e.n) ? e.p : cdl_offset(s, e.p, e.n, e.d);

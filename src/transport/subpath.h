@@ -12,6 +12,8 @@
 typedef struct cdl_walk {
     int maxdepth; /* bounces: a subpath has at most maxdepth + 1 vertices past its start */
     int rr_depth; /* Russian roulette by albedo after this many bounces */
+    int env_vertex; /* eye paths that leave the scene end on a vertex at infinity
+                     * (CDL_V_INFINITE) when the scene has an infinite light (bdpt) */
 } cdl_walk;
 
 /* Appends a light subpath (y_0 on a light, then y_1, ...) to vs, which must
@@ -33,7 +35,8 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
                                      cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc);
 
 /* Appends an eye subpath through raster point (px, py): x_0 at the camera,
- * then x_1, ... Same room needed; returns the number of vertices. */
+ * then x_1, ... Same room needed (one more with walk->env_vertex); returns
+ * the number of vertices. */
 uint32_t cdl_trace_eye_subpath(const cdl_scene *s, const cdl_camera *cam, float px, float py,
                                const cdl_walk *walk, cdl_sampler *smp, cdl_vertex_store *vs,
                                uint64_t *rays);
@@ -56,5 +59,14 @@ float cdl_light_pdf_dir(const cdl_light *l, cdl_vec3 n, cdl_vec3 w);
 /* Area (or, for delta lights, discrete) density of y_0 as a light-path
  * start: selection probability times position density. */
 float cdl_light_pdf_origin(const cdl_scene *s, int32_t light);
+/* Lights at infinity: the solid-angle density of light arriving from
+ * direction w (pointing to the light) over all of them, each weighted by
+ * its selection probability (pbrt-v3's InfiniteLightDensity; distant
+ * lights, delta in direction, add nothing). */
+float cdl_light_pdf_infinite(const cdl_scene *s, cdl_vec3 w);
+/* The density of a light path's disk point for a light at infinity
+ * (uniform on the disk covering the scene), projected onto a surface of
+ * normal n hit along w (n = 0: none). */
+float cdl_light_pdf_disk(const cdl_scene *s, cdl_vec3 w, cdl_vec3 n);
 
 #endif

@@ -16,7 +16,10 @@ enum {
     CDL_V_CAMERA = 2,   /* the camera vertex x_0 of an eye path */
     CDL_V_LIGHT = 4,    /* the vertex y_0 on a light where a light path starts */
     CDL_V_DELTA_LIGHT = 8, /* y_0 of a point or spot light (delta position) */
-    CDL_V_EMITTER = 16  /* an eye vertex lying on an area light (light >= 0) */
+    CDL_V_EMITTER = 16, /* an eye vertex lying on an area light (light >= 0) */
+    CDL_V_INFINITE = 32 /* on a light at infinity: y_0 of its light path (on the disk
+                         * covering the scene) or where an eye path left the scene;
+                         * its densities are in solid angle, as pbrt-v3's */
 };
 
 typedef struct cdl_vertex_store {
