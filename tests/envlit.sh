@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Issue 14's environment-lit scene (scenes/generated/envlit.pbrt: a pbrt-v3
+# infinite light with an EXR sky and sun over a floor, a wall and a box):
+# bdpt at N and 4N passes against path at 1024 (mean within 1 %, relMSE
+# falling at least 2.5x for 4x the passes: 1/N with the reference's own
+# noise), and pm within 3 % in the mean.
+#   envlit.sh CANDELA SCENE
+set -u
+candela=$1 scene=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+key() { sed -n "s/.*$1 \([^ ]*\) .*/\1/p"; }
+"$candela" render "$scene" -i path --spp 1024 -q -o "$tmp/path.exr" >/dev/null || exit 1
+for n in 16 64; do
+  "$candela" render "$scene" -i bdpt --spp $n -q -o "$tmp/bdpt$n.exr" >/dev/null || exit 1
+done
+"$candela" render "$scene" -i pm --spp 32 -q -o "$tmp/pm.exr" >/dev/null || exit 1
+d16=$("$candela" diff "$tmp/bdpt16.exr" "$tmp/path.exr")
+d64=$("$candela" diff "$tmp/bdpt64.exr" "$tmp/path.exr")
+dpm=$("$candela" diff "$tmp/pm.exr" "$tmp/path.exr")
+r16=$(echo "$d16" | key relmse) r64=$(echo "$d64" | key relmse)
+m64=$(echo "$d64" | key mean_ratio) mpm=$(echo "$dpm" | key mean_ratio)
+check() { if awk "BEGIN {exit !($1)}"; then echo "ok  : $2"; else echo "FAIL: $2"; fail=1; fi; }
+check "$m64 > 0.99 && $m64 < 1.01" "bdpt 64 passes / path 1024: mean $m64 (within 1 %)"
+check "$r16 / $r64 > 2.5" "bdpt relMSE against path: $r16 at 16 passes, $r64 at 64 (falls $(awk "BEGIN {printf \"%.2f\", $r16 / $r64}")x, at least 2.5x)"
+check "$mpm > 0.97 && $mpm < 1.03" "pm 32 passes / path 1024: mean $mpm (within 3 %)"
+exit $fail
