@@ -173,22 +173,32 @@ static double mean_where(const cdl_film *f, const cdl_scene *s, const cdl_camera
     return *count ? sum / *count : 0.0;
 }
 
+/* The unit square in z = 0, facing +z. */
+static const float square_z[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+
+/* A Lambertian square of albedo rho with corners p (4 x 3). */
+static void add_square(cdl_scene *s, const float *p, float rho)
+{
+    cdl_error err;
+    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
+    mat.kd = cdl_v3(rho, rho, rho);
+    uint32_t mid, first;
+    die_on(cdl_scene_add_material(s, &mat, &mid, &err), &err);
+    die_on(cdl_scene_add_vertices(s, 4, p, NULL, NULL, &first, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 1, first + 2, mid, -1, 0, &err), &err);
+    die_on(cdl_scene_add_triangle(s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
+}
+
 static void plane_under_map(const char *integ, int facing_boundary)
 {
     cdl_scene s;
     cdl_error err;
     die_on(cdl_scene_init(&s, "envplane", &err), &err);
     const float rho = 0.5f, L1 = 1.0f, L2 = 0.25f;
-    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
-    mat.kd = cdl_v3(rho, rho, rho);
-    uint32_t mid, first;
-    die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
     /* a square in x = 0 facing +x (the boundary z = 0 cuts its hemisphere
      * in halves), or in z = 0 facing +z */
-    float px[12] = {0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1}, pz[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
-    die_on(cdl_scene_add_vertices(&s, 4, facing_boundary ? px : pz, NULL, NULL, &first, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 1, first + 2, mid, -1, 0, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
+    static const float px[12] = {0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1};
+    add_square(&s, facing_boundary ? px : square_z, rho);
     die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), two_hemispheres(L1, L2, 0, zup), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
     cdl_options opt;
@@ -218,14 +228,7 @@ static void plane_under_distant(const char *integ)
     cdl_error err;
     die_on(cdl_scene_init(&s, "distantplane", &err), &err);
     const float rho = 0.5f, E = 2.0f;
-    cdl_material mat = cdl_material_default(CDL_MAT_DIFFUSE);
-    mat.kd = cdl_v3(rho, rho, rho);
-    uint32_t mid, first;
-    die_on(cdl_scene_add_material(&s, &mat, &mid, &err), &err);
-    float pz[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
-    die_on(cdl_scene_add_vertices(&s, 4, pz, NULL, NULL, &first, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 1, first + 2, mid, -1, 0, &err), &err);
-    die_on(cdl_scene_add_triangle(&s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
+    add_square(&s, square_z, rho);
     cdl_vec3 dir = cdl_normalize(cdl_v3(-0.6f, 0.2f, -1.0f)); /* the way the light travels */
     die_on(cdl_scene_add_distant_light(&s, dir, cdl_v3(E, E, E), &err), &err);
     die_on(cdl_scene_commit(&s, &err), &err);
