@@ -20,6 +20,12 @@
 static double tol_scale = 1.0;
 static uint32_t spp_div = 1;
 
+/* The integrator behind a test name ("bdpt-shared": bdpt with shared paths). */
+static const char *method(const char *integ)
+{
+    return !strcmp(integ, "bdpt-shared") ? "bdpt" : integ;
+}
+
 /* Passes for integ (pm's cost more: a photon map each) and its options. */
 static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
 {
@@ -30,6 +36,10 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
     if (!strcmp(integ, "rigi") || !strcmp(integ, "ir")) {
         opt->light_paths = 16;
         spp /= 4;
+    }
+    if (!strcmp(integ, "bdpt-shared")) { /* shared light paths in 2 x 2 sets */
+        opt->light_paths = 64;
+        opt->interleave = 2;
     }
     return spp / spp_div > 16 ? spp / spp_div : 16;
 }
@@ -209,7 +219,7 @@ static void plane_under_map(const char *integ, int facing_boundary)
     cdl_vec3 up = facing_boundary ? cdl_v3(0, 0, 1) : cdl_v3(0, 1, 0);
     die_on(cdl_camera_init(&opt.camera, eye, cdl_v3(0, 0, 0), up, 30.0f, W, H, &err), &err);
     cdl_film f;
-    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 1024), &f);
+    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 1024), &f);
     int n;
     double m = mean_where(&f, &s, &opt.camera, 1, &n);
     double expect = facing_boundary ? rho * (L1 + L2) / 2.0 : rho * L1;
@@ -239,7 +249,7 @@ static void plane_under_distant(const char *integ)
     die_on(cdl_camera_init(&opt.camera, cdl_v3(0.2f, 0.3f, 3.0f), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 30.0f, W, H, &err),
            &err);
     cdl_film f;
-    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 64), &f);
+    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 64), &f);
     int n;
     double m = mean_where(&f, &s, &opt.camera, 1, &n), expect = rho * E * -dir.z / CDL_PI;
     CHECK(n > W * H / 2 && fabs(m / expect - 1.0) < 0.01 * tol_scale,
@@ -272,7 +282,7 @@ static void sphere_under_constant(const char *integ, int equal_area)
     die_on(cdl_camera_init(&opt.camera, cdl_v3(0, 0.5f, 4), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 40.0f, W, H, &err),
            &err);
     cdl_film f;
-    render_film(integ, &s, &opt, W, H, passes(integ, &opt, 512), &f);
+    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 512), &f);
     int nh, nm;
     double on = mean_where(&f, &s, &opt.camera, 1, &nh), off = mean_where(&f, &s, &opt.camera, 0, &nm);
     CHECK(nh > 10 && fabs(on / a - 1.0) < 0.01 * tol_scale,

@@ -30,6 +30,7 @@ typedef struct bdpt_state {
     cdl_light_pool pool;
     cdl_splats *tile_splats; /* one list per tile (independent mode) or per light path batch */
     int ntiles;
+    int at_infinity; /* the scene has distant or infinite lights */
 } bdpt_state;
 
 static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err)
@@ -42,14 +43,9 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     st->threshold = cdl_default_threshold(scene, opt);
     if (st->opt.light_paths == CDL_LIGHT_PATHS_PER_SAMPLE)
         st->opt.light_paths = 0; /* bdpt's default */
-    /* lights at infinity: their s = 1 strategy is light sampling, which
-     * shared light paths do not resample */
-    for (uint32_t i = 0; st->opt.light_paths && i < scene->nlights; i++)
-        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
-            return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
-                                 "bdpt with shared light paths does not support distant or infinite lights yet "
-                                 "(--light-paths sample does)");
     st->walk.env_vertex = 1;
+    for (uint32_t i = 0; i < scene->nlights; i++)
+        st->at_infinity |= scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE;
     if (st->opt.light_paths && cdl_light_pool_init(&st->pool, st->opt.light_paths, opt->interleave,
                                                    opt->maxdepth, err))
         return err->code;
@@ -67,7 +63,7 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
  * origin density for MIS, so the weights stay a partition of unity. */
 static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *cx,
                                   const cdl_vertex_store *evs, uint32_t t, cdl_sampler *smp,
-                                  cdl_vertex_store *tmp, uint64_t *rays)
+                                  cdl_vertex_store *tmp, int only_infinite, uint64_t *rays)
 {
     const cdl_scene *s = st->scene;
     cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
@@ -86,6 +82,8 @@ static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *c
     cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f), Le = l->L;
     float pdf_area = ls.pdf; /* delta lights: 1 */
     int inf = l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
+    if (only_infinite && !inf)
+        return zero; /* shared light paths' y_0 cover the other lights */
     if (inf) {
         /* a point 2 R away along the sampled direction: the 1 / d^2 of the
          * connection's G cancels in the throughput */
@@ -151,7 +149,9 @@ static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint3
                 continue;
             }
             if (sidx == 1 && resample)
-                L = cdl_add(L, connect_resampled(st, &cx, evs, t, resample, tmp, rays));
+                L = cdl_add(L, connect_resampled(st, &cx, evs, t, resample, tmp, 0, rays));
+            else if (sidx == 1 && (lvs->flags[l0] & CDL_V_INFINITE))
+                continue; /* no point light on the disk: resampled once per eye vertex instead */
             else
                 L = cdl_add(L, cdl_connect(&cx, evs, t, lvs, l0, sidx, rays));
         }
@@ -193,16 +193,23 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                 cdl_sampler_start(&lsmp, st->opt.sampler, st->opt.seed, pix + npix, pass);
                 cdl_vs_clear(&lvs);
                 uint32_t nl = cdl_trace_light_subpath(st->scene, &st->walk, &lsmp, &lvs, rays);
-                cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f};
+                cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
                 cdl_sampler rsmp;
                 cdl_sampler_start(&rsmp, st->opt.sampler, st->opt.seed, pix + 2 * npix, pass);
                 L = combine(st, &evs, ne, &lvs, 0, nl, &cnt, 1, splats, 1.0f, &rsmp, &tvs, rays);
             } else {
                 const cdl_light_pool *lp = &st->pool;
                 uint32_t set = cdl_light_pool_set(lp, x, y), m = cdl_light_pool_set_size(lp, set);
-                cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m};
+                cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m, 1.0f, 0.0f};
                 /* pure eye paths once, connections to each path of the set */
                 L = combine(st, &evs, ne, &lvs, 0, 0, &cnt, 1, NULL, 0.0f, NULL, NULL, rays);
+                if (st->at_infinity) { /* their s = 1: light sampling, once */
+                    cdl_sampler rsmp;
+                    cdl_sampler_start(&rsmp, st->opt.sampler, st->opt.seed, pix + 2 * npix, pass);
+                    cdl_connect_ctx cx = {st->scene, cam, st->opt.mis, st->threshold, &cnt, 0};
+                    for (uint32_t t = 2; t <= ne && (int)t - 1 <= st->opt.maxdepth; t++)
+                        L = cdl_add(L, connect_resampled(st, &cx, &evs, t, &rsmp, &tvs, 1, rays));
+                }
                 cdl_vec3 Lc = cdl_v3(0.0f, 0.0f, 0.0f);
                 for (uint32_t k = set; k < lp->k; k += lp->sets)
                     Lc = cdl_add(Lc, combine(st, &evs, ne, &lp->vs, k * lp->stride, lp->len[k], &cnt, 0,
@@ -224,7 +231,7 @@ static void light_trace_pool(bdpt_state *st, cdl_film *film)
 {
     const cdl_light_pool *lp = &st->pool;
     uint64_t npix = (uint64_t)film->width * (uint64_t)film->height, rays = 0;
-    cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, 1.0f};
+    cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, 1.0f, 1.0f, 0.0f};
     float scale = (float)npix / (float)lp->k;
     int nbatch = 1024;
     cdl_vertex_store none;

@@ -146,6 +146,15 @@ static float resample_pdf(const cdl_connect_ctx *cx, int32_t li, cdl_vec3 y, cdl
     return cx->scene->light_select.pmf[li] * sa * fabsf(cdl_dot(n, w)) / (dist * dist);
 }
 
+/* The sample counts for a path whose light is (at_inf) or is not at
+ * infinity: their s = 1 strategy may be sampled differently. */
+static cdl_mis_counts path_counts(const cdl_connect_ctx *cx, int at_inf)
+{
+    cdl_mis_counts n = cx->counts ? *cx->counts : (cdl_mis_counts){1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+    n.connect_s1 = at_inf && n.s1_infinite > 0.0f ? n.s1_infinite : 0.0f;
+    return n;
+}
+
 /* MIS records of the full path: eye vertices 0..t-1, then light vertices
  * s-1..0 (indices l0 + j). */
 static void fill_records(cdl_mis_vertex *v, const cdl_vertex_store *evs, uint32_t t,
@@ -200,7 +209,8 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
                                              evs->p[i - 1], cdl_vertex_normal(evs, i - 1));
     }
     v[i].delta = 0;
-    return cdl_scale(c, cdl_mis_weight(cx->mis, v, 0, (int)t, 0, cx->counts, cx->threshold));
+    cdl_mis_counts n = path_counts(cx, inf);
+    return cdl_scale(c, cdl_mis_weight(cx->mis, v, 0, (int)t, 0, &n, cx->threshold));
 }
 
 cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t,
@@ -246,7 +256,8 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
                                        s >= 2 ? lvs->p[l0 + 1] : pp);
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
-    float w = cdl_mis_weight(cx->mis, v, (int)s, (int)t, delta_light, cx->counts, cx->threshold);
+    cdl_mis_counts n = path_counts(cx, (lvs->flags[l0] & CDL_V_INFINITE) != 0);
+    float w = cdl_mis_weight(cx->mis, v, (int)s, (int)t, delta_light, &n, cx->threshold);
     if (w <= 0.0f)
         return zero;
     (*rays)++;
@@ -297,7 +308,8 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
                        : cdl_vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
     v[1].delta = 0;
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
-    float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, cx->counts, cx->threshold);
+    cdl_mis_counts n = path_counts(cx, (lvs->flags[l0] & CDL_V_INFINITE) != 0);
+    float wgt = cdl_mis_weight(cx->mis, v, (int)s, 1, delta_light, &n, cx->threshold);
     if (wgt <= 0.0f)
         return zero;
     (*rays)++;

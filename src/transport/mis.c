@@ -9,7 +9,11 @@ static float hpow(float x, int power) { return power ? x * x : x; }
 
 static float count(const cdl_mis_counts *n, int s, int t)
 {
-    return s == 0 ? n->eye : (t == 1 ? n->light_trace : n->connect);
+    if (s == 0)
+        return n->eye;
+    if (t == 1)
+        return n->light_trace;
+    return s == 1 && n->connect_s1 > 0.0f ? n->connect_s1 : n->connect;
 }
 
 /* §3.2: the strategy whose connecting edge is the first edge, counted

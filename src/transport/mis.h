@@ -30,6 +30,10 @@ typedef struct cdl_mis_vertex {
  * subpaths per pixel sample use 1 for all three. */
 typedef struct cdl_mis_counts {
     float eye, light_trace, connect;
+    float s1_infinite; /* s = 1 samples of a path whose light is at infinity: with shared
+                        * light paths those are resampled once per eye vertex (bdpt sets
+                        * 1); 0: as connect */
+    float connect_s1;  /* the s = 1 count in effect for this path (connect.c sets it); 0: connect */
 } cdl_mis_counts;
 
 /* Weight of strategy (s, t) for the full path v[0 .. s+t-1].
