@@ -3,7 +3,8 @@
 #   fuzz.sh FUZZ_BUILD SOURCE_DIR SECONDS [CORPUS_ROOT] [TARGET...]
 # For each target: first its regression files (fuzz/regressions/TARGET, every
 # crash ever found), then SECONDS of fuzzing from a seed corpus drawn from
-# the tests' inputs (bad-input corpora, scenes, images, option rows), two
+# the tests' inputs (bad-input corpora, scenes, images, option rows; and
+# fuzz/seeds/TARGET for what the tests do not cover), two
 # targets at a time. CORPUS_ROOT keeps the corpora between runs (default: a
 # temporary directory). A crash, leak, sanitizer report or timeout fails the
 # run and leaves its input in CORPUS_ROOT/TARGET-artifacts/. Prints per target
@@ -22,6 +23,7 @@ mkdir -p "$root"
 seed() { # seed TARGET DIR
   local t=$1 d=$2 f
   mkdir -p "$d"
+  cp "$src"/fuzz/seeds/"$t"/* "$d"/ 2>/dev/null
   case $t in
     obj)
       cp "$src"/tests/bad_input/*.obj "$d"/ 2>/dev/null
