@@ -199,6 +199,19 @@ static void add_square(cdl_scene *s, const float *p, float rho)
     die_on(cdl_scene_add_triangle(s, first, first + 2, first + 3, mid, -1, 0, &err), &err);
 }
 
+/* Commits s and renders it 16 x 16 from eye towards the origin with
+ * integ's passes for spp; opt gets the camera. */
+static void render_view(const char *integ, cdl_scene *s, cdl_vec3 eye, cdl_vec3 up, float fov, uint32_t spp,
+                        cdl_options *opt, cdl_film *f)
+{
+    cdl_error err;
+    die_on(cdl_scene_commit(s, &err), &err);
+    cdl_options_default(opt);
+    opt->maxdepth = 4;
+    die_on(cdl_camera_init(&opt->camera, eye, cdl_v3(0, 0, 0), up, fov, 16, 16, &err), &err);
+    render_film(method(integ), s, opt, 16, 16, passes(integ, opt, spp), f);
+}
+
 static void plane_under_map(const char *integ, int facing_boundary)
 {
     cdl_scene s;
@@ -210,16 +223,12 @@ static void plane_under_map(const char *integ, int facing_boundary)
     static const float px[12] = {0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1};
     add_square(&s, facing_boundary ? px : square_z, rho);
     die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), two_hemispheres(L1, L2, 0, zup), &err), &err);
-    die_on(cdl_scene_commit(&s, &err), &err);
     cdl_options opt;
-    cdl_options_default(&opt);
-    opt.maxdepth = 4;
+    cdl_film f;
     int W = 16, H = 16;
     cdl_vec3 eye = facing_boundary ? cdl_v3(3.0f, 0.2f, 0.3f) : cdl_v3(0.2f, 0.3f, 3.0f);
     cdl_vec3 up = facing_boundary ? cdl_v3(0, 0, 1) : cdl_v3(0, 1, 0);
-    die_on(cdl_camera_init(&opt.camera, eye, cdl_v3(0, 0, 0), up, 30.0f, W, H, &err), &err);
-    cdl_film f;
-    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 1024), &f);
+    render_view(integ, &s, eye, up, 30.0f, 1024, &opt, &f);
     int n;
     double m = mean_where(&f, &s, &opt.camera, 1, &n);
     double expect = facing_boundary ? rho * (L1 + L2) / 2.0 : rho * L1;
@@ -241,15 +250,10 @@ static void plane_under_distant(const char *integ)
     add_square(&s, square_z, rho);
     cdl_vec3 dir = cdl_normalize(cdl_v3(-0.6f, 0.2f, -1.0f)); /* the way the light travels */
     die_on(cdl_scene_add_distant_light(&s, dir, cdl_v3(E, E, E), &err), &err);
-    die_on(cdl_scene_commit(&s, &err), &err);
     cdl_options opt;
-    cdl_options_default(&opt);
-    opt.maxdepth = 4;
-    int W = 16, H = 16;
-    die_on(cdl_camera_init(&opt.camera, cdl_v3(0.2f, 0.3f, 3.0f), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 30.0f, W, H, &err),
-           &err);
     cdl_film f;
-    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 64), &f);
+    int W = 16, H = 16;
+    render_view(integ, &s, cdl_v3(0.2f, 0.3f, 3.0f), cdl_v3(0, 1, 0), 30.0f, 64, &opt, &f);
     int n;
     double m = mean_where(&f, &s, &opt.camera, 1, &n), expect = rho * E * -dir.z / CDL_PI;
     CHECK(n > W * H / 2 && fabs(m / expect - 1.0) < 0.01 * tol_scale,
@@ -274,15 +278,9 @@ static void sphere_under_constant(const char *integ, int equal_area)
         die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), equal_area_map(1.0f, 1.0f, 0), &err), &err);
     else
         die_on(cdl_scene_add_infinite_light(&s, cdl_v3(1, 1, 1), &err), &err);
-    die_on(cdl_scene_commit(&s, &err), &err);
     cdl_options opt;
-    cdl_options_default(&opt);
-    opt.maxdepth = 4;
-    int W = 16, H = 16;
-    die_on(cdl_camera_init(&opt.camera, cdl_v3(0, 0.5f, 4), cdl_v3(0, 0, 0), cdl_v3(0, 1, 0), 40.0f, W, H, &err),
-           &err);
     cdl_film f;
-    render_film(method(integ), &s, &opt, W, H, passes(integ, &opt, 512), &f);
+    render_view(integ, &s, cdl_v3(0, 0.5f, 4), cdl_v3(0, 1, 0), 40.0f, 512, &opt, &f);
     int nh, nm;
     double on = mean_where(&f, &s, &opt.camera, 1, &nh), off = mean_where(&f, &s, &opt.camera, 0, &nm);
     CHECK(nh > 10 && fabs(on / a - 1.0) < 0.01 * tol_scale,

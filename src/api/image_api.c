@@ -74,7 +74,7 @@ int cdl_image_crop(const cdl_image *img, int x0, int y0, int x1, int y1, cdl_ima
         return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_image_crop: no image or no place for the crop");
     *out = NULL;
     if (x0 < 0 || y0 < 0 || x1 <= x0 || y1 <= y0 || x1 > img->width || y1 > img->height)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--region", 0, "%d,%d,%d,%d is empty or reaches outside the %dx%d image",
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "crop %d,%d,%d,%d is empty or reaches outside the %dx%d image",
                              x0, y0, x1, y1, img->width, img->height);
     int rc = cdl_image_create(x1 - x0, y1 - y0, out, err);
     for (int y = 0; !rc && y < y1 - y0; y++)

@@ -2,8 +2,9 @@
  * command's --help and the Python package's discovery read this table),
  * the integrators and the version. Each entry is parsed in settings.c. */
 #include <stddef.h>
+#include <string.h>
 
-#include "integrators/integrator.h"
+#include "api/settings.h"
 
 #define STR2(x) #x
 #define STR(x) STR2(x)
@@ -89,6 +90,14 @@ int cdl_option_count(void)
 const cdl_option_info *cdl_option_get(int i)
 {
     return i >= 0 && i < cdl_option_count() ? &options[i] : NULL;
+}
+
+const cdl_option_info *cdl_option_find(const char *name)
+{
+    for (int i = 0; i < cdl_option_count(); i++)
+        if (!strcmp(options[i].name, name))
+            return &options[i];
+    return NULL;
 }
 
 int cdl_integrator_count(void)

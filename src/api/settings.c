@@ -89,11 +89,6 @@ static int option_name(const char *name, char *o, size_t n, cdl_error *err)
     return 0;
 }
 
-static const char *valued[] = {"--integrator", "--spp", "--time", "--res", "--lookat", "--fov", "--maxdepth",
-                               "--seed", "--threads", "--point-light", "--exposure", "--sampler", "--mis",
-                               "--light-paths", "--interleave", "--threshold", "--clamp", "--strata",
-                               "--shadow-rays", "--aov"};
-
 static int set(cdl_settings *a, const char *o, const char *v, cdl_error *err)
 {
     if (!strcmp(o, "--quiet")) {
@@ -116,10 +111,7 @@ static int set(cdl_settings *a, const char *o, const char *v, cdl_error *err)
             a->pm.discard = 0;
         return 0;
     }
-    int known = pk || cdl_gkde_arg_kind(o) || cdl_splat_arg_kind(o);
-    for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
-        known |= !strcmp(o, valued[k]);
-    if (!known)
+    if (!cdl_option_find(o + (o[1] == '-' ? 2 : 1))) /* the table --help lists */
         return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "unknown option (see candela render --help)");
     if (!v)
         return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expects a value");

@@ -9,6 +9,9 @@
 
 #define CDL_MAX_POINT_LIGHTS 64
 
+/* The option table's entry called name ("photons", "C"; no dashes), or NULL. */
+const cdl_option_info *cdl_option_find(const char *name);
+
 struct cdl_settings {
     char integrator[32];
     long spp;

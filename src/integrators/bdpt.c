@@ -45,7 +45,7 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
         st->opt.light_paths = 0; /* bdpt's default */
     st->walk.env_vertex = 1;
     for (uint32_t i = 0; i < scene->nlights; i++)
-        st->at_infinity |= scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE;
+        st->at_infinity |= cdl_light_at_infinity(&scene->lights[i]);
     if (st->opt.light_paths && cdl_light_pool_init(&st->pool, st->opt.light_paths, opt->interleave,
                                                    opt->maxdepth, err))
         return err->code;
@@ -81,7 +81,7 @@ static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *c
         return zero;
     cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f), Le = l->L;
     float pdf_area = ls.pdf; /* delta lights: 1 */
-    int inf = l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
+    int inf = cdl_light_at_infinity(l);
     if (only_infinite && !inf)
         return zero; /* shared light paths' y_0 cover the other lights */
     if (inf) {

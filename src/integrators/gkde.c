@@ -56,7 +56,7 @@ static int gkde_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     if (!scene->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "gkde: the scene has no lights");
     for (uint32_t i = 0; i < scene->nlights; i++)
-        if (scene->lights[i].type == CDL_LIGHT_DISTANT || scene->lights[i].type == CDL_LIGHT_INFINITE)
+        if (cdl_light_at_infinity(&scene->lights[i]))
             return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
                                  "gkde does not support distant or infinite lights yet");
     size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;

@@ -34,6 +34,7 @@
 #include "integrators/integrator.h"
 #include "transport/connect.h"
 #include "transport/light_pool.h"
+#include "transport/light_select.h"
 
 typedef struct rigi_state {
     const cdl_scene *scene;
@@ -47,10 +48,6 @@ typedef struct rigi_state {
     cdl_light_pool pool;
 } rigi_state;
 
-static int at_infinity(const cdl_light *l)
-{
-    return l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
-}
 
 static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, int clamped,
                    cdl_error *err)
@@ -73,7 +70,7 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
         st->t = cdl_default_threshold(scene, opt);
     st->at_infinity = 0;
     for (uint32_t i = 0; i < scene->nlights; i++)
-        st->at_infinity |= at_infinity(&scene->lights[i]);
+        st->at_infinity |= cdl_light_at_infinity(&scene->lights[i]);
     st->per_sample = opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE;
     if (st->per_sample)
         return opt->interleave > 1 ? cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0,
@@ -134,22 +131,9 @@ static cdl_vec3 light_at_infinity(const cdl_scene *s, const cdl_surface *sf, con
                                   cdl_sampler *smp, uint64_t *rays)
 {
     cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
-    for (uint32_t i = 0; i < s->nlights; i++) {
-        const cdl_light *l = &s->lights[i];
-        if (!at_infinity(l))
-            continue;
-        float u1, u2;
-        cdl_sampler_2d(smp, &u1, &u2);
-        cdl_light_sample ls;
-        if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls) || !(ls.pdf > 0.0f))
-            continue;
-        cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
-        if (cdl_is_black(f))
-            continue;
-        (*rays)++;
-        if (cdl_light_sample_visible(s, l, sf->p, sf->ng, &ls))
-            L = cdl_add(L, cdl_scale(cdl_mul(f, ls.Li), fabsf(cdl_dot(ls.wi, b->frame.n)) / ls.pdf));
-    }
+    for (uint32_t i = 0; i < s->nlights; i++)
+        if (cdl_light_at_infinity(&s->lights[i]))
+            L = cdl_add(L, cdl_sample_light(s, i, sf, b, wo, smp, rays));
     return L;
 }
 
@@ -283,7 +267,7 @@ static void connect_set(const rigi_state *st, const cdl_light_pool *lp, tile_wor
             uint32_t y = base + j;
             if (lv->flags[y] & CDL_V_DELTA)
                 continue; /* specular light vertices are not point lights */
-            if (j == 0 && at_infinity(&st->scene->lights[lv->light[y]]))
+            if (j == 0 && cdl_light_at_infinity(&st->scene->lights[lv->light[y]]))
                 continue; /* light sampling covers lights at infinity */
             int delta_pos = (lv->flags[y] & CDL_V_DELTA_LIGHT) != 0;
             cdl_vec3 yp = lv->p[y], yn = cdl_vertex_normal(lv, y);

@@ -156,8 +156,11 @@ int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_v
     } else {
         rc = cdl_image_read(path, &img, err);
     }
-    if (rc)
-        return err && !err->file[0] ? cdl_error_set(err, err->code, path, 0, "%s", err->msg) : rc;
+    if (rc) {
+        if (err && !err->file[0]) /* the allocation's error names no file */
+            snprintf(err->file, sizeof err->file, "%s", path);
+        return rc;
+    }
     size_t n = (size_t)img.width * (size_t)img.height;
     for (size_t i = 0; i < 3 * n; i++) {
         float s = i % 3 == 0 ? scale.x : i % 3 == 1 ? scale.y : scale.z;

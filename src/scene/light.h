@@ -59,6 +59,12 @@ static inline int cdl_light_is_delta(const cdl_light *l)
     return l->type == CDL_LIGHT_POINT || l->type == CDL_LIGHT_SPOT || l->type == CDL_LIGHT_DISTANT;
 }
 
+/* Distant and infinite lights: outside the scene, reached along directions. */
+static inline int cdl_light_at_infinity(const cdl_light *l)
+{
+    return l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
+}
+
 /* Returns 0 if the sample carries no light (back face, outside a cone). */
 int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
                         cdl_light_sample *s);

@@ -238,7 +238,6 @@ typedef struct obj_ctx {
     const char *path;
     cdl_error *err;
     long nv, nvt, nvn, nfaces;
-    int last_count; /* numbers on the last line obj_numbers read */
     mtl_names names;
     int nmtllib;
     /* first usemtl of each name is checked once all MTLs are read */
@@ -249,7 +248,7 @@ typedef struct obj_ctx {
 } obj_ctx;
 
 static int obj_numbers(obj_ctx *c, line_cursor *lc, const char *key, int line, int min, int max,
-                       float limit)
+                       float limit, int *count)
 {
     int n = 0;
     char *w;
@@ -267,7 +266,8 @@ static int obj_numbers(obj_ctx *c, line_cursor *lc, const char *key, int line, i
                                  "%s: coordinate %s is not finite or beyond %g", key, w, (double)limit);
         n++;
     }
-    c->last_count = n;
+    if (count)
+        *count = n;
     if (n < min || n > max)
         return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, line, "%s expects %d to %d numbers, got %d",
                              key, min, max, n);
@@ -333,21 +333,21 @@ static int obj_line(void *vc, char *line, int lineno)
         return 0;
     if (!strcmp(key, "v")) {
         c->nv++;
-        int n = obj_numbers(c, &lc, key, lineno, 3, 6, CDL_MAX_COORD);
+        int n = 0, rc = obj_numbers(c, &lc, key, lineno, 3, 6, CDL_MAX_COORD, &n);
         /* Assimp reads x y z, x y z w or x y z r g b, and drops any other
          * count's vertex, which shifts every later index */
-        if (!n && c->last_count == 5)
+        if (!rc && n == 5)
             return cdl_error_set(c->err, CDL_ERR_INPUT, c->path, lineno,
                                  "v expects 3 (x y z), 4 (x y z w) or 6 (x y z r g b) numbers, got 5");
-        return n;
+        return rc;
     }
     if (!strcmp(key, "vt")) {
         c->nvt++;
-        return obj_numbers(c, &lc, key, lineno, 1, 3, CDL_MAX_COORD);
+        return obj_numbers(c, &lc, key, lineno, 1, 3, CDL_MAX_COORD, NULL);
     }
     if (!strcmp(key, "vn")) {
         c->nvn++;
-        return obj_numbers(c, &lc, key, lineno, 3, 3, CDL_MAX_COORD);
+        return obj_numbers(c, &lc, key, lineno, 3, 3, CDL_MAX_COORD, NULL);
     }
     if (!strcmp(key, "f"))
         return obj_face(c, &lc, lineno);

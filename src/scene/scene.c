@@ -299,7 +299,7 @@ static int build_lights(cdl_scene *s, cdl_error *err)
     s->env_light = -1;
     for (uint32_t i = 0; i < s->nlights; i++) {
         cdl_light *l = &s->lights[i];
-        if (l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE) {
+        if (cdl_light_at_infinity(l)) {
             l->p = centre;
             l->radius = radius > 0.0f ? radius : 1.0f;
         }

@@ -95,8 +95,18 @@ float cdl_vertex_pdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint
     if (!(len > 0.0f))
         return 0.0f;
     if (vs->flags[i] & CDL_V_INFINITE) /* a light at infinity reaches `to` from its disk */
-        return cdl_light_pdf_disk(cx->scene, cdl_scale(w, 1.0f / len), nt);
+        return cdl_light_pdf_disk(&cx->scene->lights[vs->light[i]], cdl_scale(w, 1.0f / len), nt);
     return cdl_pdf_to_area(cdl_vertex_pdf_sa(cx, vs, i, from, cdl_scale(w, 1.0f / len)), p, to, nt);
+}
+
+/* The density of vertex i (of vs, reached from `from`) choosing vertex j
+ * of ws: in area measure, or in solid angle when j lies at infinity. */
+static float pdf_to(const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t i, cdl_vec3 from,
+                    const cdl_vertex_store *ws, uint32_t j)
+{
+    if (ws->flags[j] & CDL_V_INFINITE)
+        return cdl_vertex_pdf_sa(cx, vs, i, from, cdl_normalize(cdl_sub(ws->p[j], vs->p[i])));
+    return cdl_vertex_pdf(cx, vs, i, from, ws->p[j], cdl_vertex_normal(ws, j));
 }
 
 /* f at vertex i for light arriving from `from` and leaving to `to` (eye
@@ -200,7 +210,7 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
     fill_records(v, evs, t, NULL, 0, 0, cx->mis == CDL_MIS_STRATIFIED);
     if (inf) { /* pbrt-v3's densities for a light at infinity */
         v[i].pdf_light = cdl_light_pdf_infinite(cx->scene, d);
-        v[i - 1].pdf_light = cdl_light_pdf_disk(cx->scene, d, cdl_vertex_normal(evs, i - 1));
+        v[i - 1].pdf_light = cdl_light_pdf_disk(l, d, cdl_vertex_normal(evs, i - 1));
         v[i - 1].g_next = 0.0f; /* G to infinity */
     } else {
         v[i].pdf_light = cdl_light_pdf_origin(cx->scene, evs->light[i]);
@@ -240,18 +250,13 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
     cdl_vec3 np = cdl_vertex_normal(evs, pt), nq = cdl_vertex_normal(lvs, qs);
     v[pt].g_next = cdl_geometry(pp, np, qp, nq);
     /* densities through the new edge, both ways (pbrt-v3's MISWeight) */
-    v[pt].pdf_light = cdl_vertex_pdf(cx, lvs, qs, qm, pp, np);
-    v[pt - 1].pdf_light = cdl_vertex_pdf(cx, evs, pt, qp, pm, cdl_vertex_normal(evs, pt - 1));
-    v[t].pdf_eye = cdl_vertex_pdf(cx, evs, pt, pm, qp, nq);
-    if (lvs->flags[qs] & CDL_V_INFINITE) { /* densities of directions there */
-        v[t].pdf_eye = cdl_vertex_pdf_sa(cx, evs, pt, pm, cdl_normalize(cdl_sub(qp, pp)));
-        v[pt].g_next = 0.0f;
-    }
-    if (s >= 2) {
-        v[t + 1].pdf_eye = cdl_vertex_pdf(cx, lvs, qs, pp, qm, cdl_vertex_normal(lvs, qs - 1));
-        if (lvs->flags[qs - 1] & CDL_V_INFINITE)
-            v[t + 1].pdf_eye = cdl_vertex_pdf_sa(cx, lvs, qs, pp, cdl_normalize(cdl_sub(qm, qp)));
-    }
+    v[pt].pdf_light = pdf_to(cx, lvs, qs, qm, evs, pt);
+    v[pt - 1].pdf_light = pdf_to(cx, evs, pt, qp, evs, pt - 1);
+    v[t].pdf_eye = pdf_to(cx, evs, pt, pm, lvs, qs);
+    if (lvs->flags[qs] & CDL_V_INFINITE)
+        v[pt].g_next = 0.0f; /* G to infinity */
+    if (s >= 2)
+        v[t + 1].pdf_eye = pdf_to(cx, lvs, qs, pp, lvs, qs - 1);
     v[pt].delta = v[t].delta = 0;
     v[s + t - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0],
                                        s >= 2 ? lvs->p[l0 + 1] : pp);
@@ -303,9 +308,7 @@ cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *l
     v[s].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
     cdl_vec3 nq = cdl_vertex_normal(lvs, qs);
     v[1].pdf_eye = cdl_pdf_to_area(pdf_cam, cam->eye, qp, nq);
-    v[2].pdf_eye = (lvs->flags[qs - 1] & CDL_V_INFINITE)
-                       ? cdl_vertex_pdf_sa(cx, lvs, qs, cam->eye, cdl_normalize(cdl_sub(qm, qp)))
-                       : cdl_vertex_pdf(cx, lvs, qs, cam->eye, qm, cdl_vertex_normal(lvs, qs - 1));
+    v[2].pdf_eye = pdf_to(cx, lvs, qs, cam->eye, lvs, qs - 1);
     v[1].delta = 0;
     int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
     cdl_mis_counts n = path_counts(cx, (lvs->flags[l0] & CDL_V_INFINITE) != 0);

@@ -43,7 +43,7 @@ uint32_t cdl_lcon_query(const cdl_scene *s, const cdl_photon_map *direct, cdl_ve
 {
     lcon_ctx c = {direct, sc, 0};
     for (uint32_t l = 0; l < s->nlights; l++)
-        if (s->lights[l].type == CDL_LIGHT_DISTANT || s->lights[l].type == CDL_LIGHT_INFINITE ||
+        if (cdl_light_at_infinity(&s->lights[l]) ||
             l >= CDL_PH_NO_LIGHT) {
             sc->mark[l] = 1;
             sc->ids[c.n++] = l;
@@ -62,10 +62,8 @@ uint32_t cdl_lcon_query(const cdl_scene *s, const cdl_photon_map *direct, cdl_ve
     return c.n;
 }
 
-/* f L cos / pdf of one point on light l (one shadow ray), not divided by
- * the light's selection probability. */
-static cdl_vec3 sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf, const cdl_bsdf *b,
-                             cdl_vec3 wo, cdl_sampler *smp, uint64_t *rays)
+cdl_vec3 cdl_sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
+                          cdl_sampler *smp, uint64_t *rays)
 {
     const cdl_light *l = &s->lights[li];
     float u1, u2;
@@ -98,7 +96,7 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
             cdl_sampler_2d(smp, &us, &ua);
             uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
             if (pmf > 0.0f)
-                L = cdl_add(L, cdl_scale(sample_light(s, li, sf, b, wo, smp, rays), 1.0f / pmf));
+                L = cdl_add(L, cdl_scale(cdl_sample_light(s, li, sf, b, wo, smp, rays), 1.0f / pmf));
         }
         return cdl_scale(L, 1.0f / (float)S);
     }
@@ -121,7 +119,7 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
                 cdl_vec3 Lj = cdl_v3(0.0f, 0.0f, 0.0f);
                 for (uint32_t r = 0; r < nj; r++) {
                     smp->dim = base + 2 + sc->ids[j] * stride + (r < stride ? r : stride - 1);
-                    Lj = cdl_add(Lj, sample_light(s, sc->ids[j], sf, b, wo, smp, rays));
+                    Lj = cdl_add(Lj, cdl_sample_light(s, sc->ids[j], sf, b, wo, smp, rays));
                 }
                 L = cdl_add(L, cdl_scale(Lj, 1.0f / (float)nj));
             }
@@ -138,7 +136,7 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
                 }
                 float pmf = pw[sc->ids[j]] / W;
                 if (pmf > 0.0f)
-                    L = cdl_add(L, cdl_scale(sample_light(s, sc->ids[j], sf, b, wo, smp, rays),
+                    L = cdl_add(L, cdl_scale(cdl_sample_light(s, sc->ids[j], sf, b, wo, smp, rays),
                                              1.0f / (pmf * (float)S)));
             }
         }
@@ -151,7 +149,7 @@ cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lco
         r = r < rest ? r : rest - 1;
         for (uint32_t j = 0; j < n && sc->ids[j] <= r; j++)
             r++; /* the r-th index not in the sorted L_con */
-        L = cdl_add(L, cdl_scale(sample_light(s, r, sf, b, wo, smp, rays), (float)rest));
+        L = cdl_add(L, cdl_scale(cdl_sample_light(s, r, sf, b, wo, smp, rays), (float)rest));
     }
     uint32_t used = 2 + s->nlights * stride, drawn = 2 + 2 * S;
     smp->dim = base + (used > drawn ? used : drawn);

@@ -38,6 +38,11 @@ typedef struct cdl_direct_cfg {
     float r2;                    /* L_con query radius squared */
 } cdl_direct_cfg;
 
+/* f L cos / pdf of one point on light li (one shadow ray), not divided by
+ * the light's selection probability. */
+cdl_vec3 cdl_sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
+                          cdl_sampler *smp, uint64_t *rays);
+
 /* Reflected direct light at a surface point towards wo. *nlcon gets |L_con|. */
 cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lcon_scratch *sc,
                           const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo, cdl_sampler *smp,

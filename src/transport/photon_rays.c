@@ -243,7 +243,7 @@ static int check_lights(const cdl_scene *s, cdl_error *err)
     if (!s->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "the scene has no lights: no photons to trace");
     for (uint32_t i = 0; i < s->nlights; i++)
-        if (s->lights[i].type != CDL_LIGHT_DISTANT && s->lights[i].type != CDL_LIGHT_INFINITE &&
+        if (!cdl_light_at_infinity(&s->lights[i]) &&
             s->light_select.pmf[i] > 0.0f)
             return 0;
     return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,

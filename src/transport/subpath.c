@@ -32,19 +32,13 @@ float cdl_light_pdf_origin(const cdl_scene *s, int32_t light)
 
 float cdl_light_pdf_infinite(const cdl_scene *s, cdl_vec3 w)
 {
-    float pdf = 0.0f;
-    for (uint32_t i = 0; i < s->nlights; i++)
-        if (s->lights[i].type == CDL_LIGHT_INFINITE)
-            pdf += s->light_select.pmf[i] * cdl_light_pdf_li(&s->lights[i], cdl_v3(0, 0, 0), w, FLT_MAX);
-    return pdf;
+    int32_t e = s->env_light; /* the one infinite light there may be */
+    return e < 0 ? 0.0f : s->light_select.pmf[e] * cdl_light_pdf_li(&s->lights[e], cdl_v3(0, 0, 0), w, FLT_MAX);
 }
 
-float cdl_light_pdf_disk(const cdl_scene *s, cdl_vec3 w, cdl_vec3 n)
+float cdl_light_pdf_disk(const cdl_light *l, cdl_vec3 w, cdl_vec3 n)
 {
-    float r = 0.5f * cdl_length(cdl_sub(s->bmax, s->bmin));
-    if (!(r > 0.0f))
-        r = 1.0f;
-    float pdf = 1.0f / (CDL_PI * r * r);
+    float pdf = 1.0f / (CDL_PI * l->radius * l->radius); /* as cdl_light_sample_le's pdf_pos */
     return cdl_is_black(n) ? pdf : pdf * fabsf(cdl_dot(n, w));
 }
 
@@ -101,7 +95,7 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
         vs->wi[i] = cdl_neg(d);
         vs->beta[i] = beta;
         /* after a light at infinity: the disk's density, projected */
-        vs->pdf_fwd[i] = (vs->flags[prev] & CDL_V_INFINITE) ? cdl_light_pdf_disk(s, d, sf.ng)
+        vs->pdf_fwd[i] = (vs->flags[prev] & CDL_V_INFINITE) ? cdl_light_pdf_disk(&s->lights[vs->light[prev]], d, sf.ng)
                                                              : cdl_pdf_to_area(pdf_dir, vs->p[prev], sf.p, sf.ng);
         vs->u[i] = sf.u;
         vs->v[i] = sf.v;
@@ -193,7 +187,7 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     vs->light[i] = (int32_t)li;
     vs->depth[i] = 0;
     vs->flags[i] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0);
-    if (l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE) {
+    if (cdl_light_at_infinity(l)) {
         /* pbrt-v3: y_0's density is that of its direction, y_1's that of
          * the disk point (set in random_walk) */
         vs->flags[i] |= CDL_V_INFINITE;

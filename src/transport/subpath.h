@@ -60,13 +60,13 @@ float cdl_light_pdf_dir(const cdl_light *l, cdl_vec3 n, cdl_vec3 w);
  * start: selection probability times position density. */
 float cdl_light_pdf_origin(const cdl_scene *s, int32_t light);
 /* Lights at infinity: the solid-angle density of light arriving from
- * direction w (pointing to the light) over all of them, each weighted by
- * its selection probability (pbrt-v3's InfiniteLightDensity; distant
- * lights, delta in direction, add nothing). */
+ * direction w (pointing to the light), weighted by its selection
+ * probability (pbrt-v3's InfiniteLightDensity: the infinite light's;
+ * distant lights, delta in direction, add nothing). */
 float cdl_light_pdf_infinite(const cdl_scene *s, cdl_vec3 w);
-/* The density of a light path's disk point for a light at infinity
+/* The density of a light path's disk point for light l at infinity
  * (uniform on the disk covering the scene), projected onto a surface of
  * normal n hit along w (n = 0: none). */
-float cdl_light_pdf_disk(const cdl_scene *s, cdl_vec3 w, cdl_vec3 n);
+float cdl_light_pdf_disk(const cdl_light *l, cdl_vec3 w, cdl_vec3 n);
 
 #endif
