@@ -10,7 +10,7 @@ set -eu
 cd "$(dirname "$0")/.."
 secs=${1:-600}
 shift || true
-cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DCDL_FUZZ=ON -DBUILD_TESTING=OFF \
+cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCDL_FUZZ=ON -DBUILD_TESTING=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCDL_NATIVE=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz >/dev/null
 exec tests/fuzz.sh build-fuzz "$PWD" "$secs" "$PWD/fuzz/corpus" "$@"

@@ -330,6 +330,7 @@ static void test_microfacet(const mf_case *mc, double wo_deg, int tilted, uint64
     m2.k3 = m3.k3 = cdl_v3(PERFECT_K, PERFECT_K, PERFECT_K);
     m2.kd = cdl_v3(0.0f, 0.0f, 0.0f);
     m3.type = CDL_MAT_CONDUCTOR;
+    m3.ks = cdl_v3(1.0f, 1.0f, 1.0f); /* a conductor's ks scales it */
     cdl_bsdf b, b2, b3;
     cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
     cdl_bsdf_init(&b2, &m2, m2.kd, to_f(nsd), to_f(ngd));

@@ -20,7 +20,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 # Fuzzing over the public API (clang + libFuzzer, ASan + UBSan): every
 # regression input of fuzz/regressions, then 30 s per reader (OBJ/MTL, pbrt,
 # PLY, images, options) from seeds drawn from the tests' inputs.
-cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DCDL_FUZZ=ON -DBUILD_TESTING=OFF \
+cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCDL_FUZZ=ON -DBUILD_TESTING=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCDL_NATIVE=OFF >/dev/null
 cmake --build build-fuzz -j"$jobs" --target fuzz
 tests/fuzz.sh build-fuzz "$PWD" 30

@@ -120,7 +120,8 @@ static cdl_vec3 opaque_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *
         return f;
     case CDL_MAT_CONDUCTOR: {
         float m = ggx_reflect(b, lo, li, pdf, &cos_h);
-        return cdl_scale(cdl_fresnel_conductor(cos_h, b->eta3, b->k3), m);
+        /* ks: Mitsuba's specular_reflectance factor (1 for pbrt's metals) */
+        return cdl_scale(cdl_mul(b->ks, cdl_fresnel_conductor(cos_h, b->eta3, b->k3)), m);
     }
     case CDL_MAT_PLASTIC: {
         float m = ggx_reflect(b, lo, li, &ps, &cos_h);

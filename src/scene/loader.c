@@ -5,6 +5,7 @@
 #include <strings.h>
 
 #include "scene/obj_check.h"
+#include "scene/mitsuba_loader.h"
 #include "scene/obj_loader.h"
 #include "scene/pbrt_loader.h"
 
@@ -30,6 +31,8 @@ int cdl_scene_load(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_
         return cdl_load_obj(s, path, err);
     if (has_ext(path, ".pbrt"))
         return cdl_load_pbrt(s, path, set, err);
+    if (has_ext(path, ".xml"))
+        return cdl_load_mitsuba(s, path, set, err);
     /* A missing file is a clearer message than an unknown format. */
     char *data;
     size_t size;
@@ -37,5 +40,5 @@ int cdl_scene_load(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_
     if (rc)
         return rc;
     free(data);
-    return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "unknown scene format (expected .obj or .pbrt)");
+    return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "unknown scene format (expected .obj, .pbrt or Mitsuba .xml)");
 }

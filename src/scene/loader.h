@@ -1,5 +1,5 @@
-/* Scene files by extension: .obj (Wavefront OBJ + MTL through Assimp) and
- * .pbrt (pbrt-v3/v4 scene description). */
+/* Scene files by extension: .obj (Wavefront OBJ + MTL through Assimp),
+ * .pbrt (pbrt-v3/v4 scene description) and .xml (Mitsuba 0.6 / 3). */
 #ifndef CDL_LOADER_H
 #define CDL_LOADER_H
 

@@ -24,7 +24,7 @@ typedef struct cdl_material {
     cdl_mat_type type;
     cdl_vec3 kd;      /* diffuse reflectance, multiplied by the texture */
     int kd_tex;       /* texture index or -1 */
-    cdl_vec3 ks;      /* specular reflectance (Phong, mirror, plastic, glass Kr) */
+    cdl_vec3 ks;      /* specular reflectance (Phong, mirror, plastic, glass Kr; conductor: a factor) */
     cdl_vec3 kt;      /* specular transmittance (glass Kt) */
     float ns;         /* Phong exponent */
     float eta;        /* index of refraction (dielectric, plastic coat) */

@@ -205,3 +205,70 @@ int cdl_load_obj(cdl_scene *s, const char *path, cdl_error *err)
     aiReleaseImport(as);
     return rc;
 }
+
+int cdl_obj_read_mesh(const char *path, cdl_mesh *m, cdl_error *err)
+{
+    memset(m, 0, sizeof *m);
+    int rc = cdl_obj_check(path, err);
+    if (rc)
+        return rc;
+    const struct aiScene *as = aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                                                      aiProcess_SortByPType);
+    if (!as || !as->mRootNode) {
+        rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0, "import failed: %s", aiGetErrorString());
+        aiReleaseImport(as);
+        return rc;
+    }
+    uint64_t nv = 0, nt = 0;
+    int has_n = 1, has_uv = 1;
+    for (unsigned mi = 0; mi < as->mNumMeshes; mi++) {
+        const struct aiMesh *am = as->mMeshes[mi];
+        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+            continue;
+        nv += am->mNumVertices;
+        nt += am->mNumFaces;
+        has_n &= am->mNormals != NULL;
+        has_uv &= am->mTextureCoords[0] != NULL;
+    }
+    if (nt == 0 || nv >= UINT32_MAX / 4 || nt >= UINT32_MAX / 4)
+        rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0, nt ? "too many vertices or faces" : "no triangles");
+    if (!rc)
+        rc = cdl_mesh_alloc(m, (uint32_t)nv, (uint32_t)nt, has_n, has_uv, path, 0, err);
+    uint32_t v0 = 0, t = 0;
+    for (unsigned mi = 0; mi < as->mNumMeshes && !rc; mi++) {
+        const struct aiMesh *am = as->mMeshes[mi];
+        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+            continue;
+        for (uint32_t v = 0; v < am->mNumVertices; v++) {
+            float *p = m->pos + 3 * (size_t)(v0 + v);
+            p[0] = am->mVertices[v].x, p[1] = am->mVertices[v].y, p[2] = am->mVertices[v].z;
+            if (has_n) {
+                float *n = m->nrm + 3 * (size_t)(v0 + v);
+                n[0] = am->mNormals[v].x, n[1] = am->mNormals[v].y, n[2] = am->mNormals[v].z;
+            }
+            if (has_uv) {
+                m->uv[2 * (size_t)(v0 + v)] = am->mTextureCoords[0][v].x;
+                m->uv[2 * (size_t)(v0 + v) + 1] = am->mTextureCoords[0][v].y;
+            }
+        }
+        for (unsigned f = 0; f < am->mNumFaces; f++) {
+            const struct aiFace *face = &am->mFaces[f];
+            if (face->mNumIndices != 3)
+                continue; /* points and lines are not surfaces */
+            for (int k = 0; k < 3; k++) {
+                if (face->mIndices[k] >= am->mNumVertices) {
+                    rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0, "face index out of range");
+                    break;
+                }
+                m->idx[3 * (size_t)t + k] = v0 + face->mIndices[k];
+            }
+            t++;
+        }
+        v0 += am->mNumVertices;
+    }
+    m->ntris = t;
+    aiReleaseImport(as);
+    if (rc)
+        cdl_mesh_free(m);
+    return rc;
+}

@@ -9,6 +9,7 @@
 
 #include "core/transform.h"
 #include "scene/loader.h"
+#include "scene/mesh.h"
 #include "scene/pbrt_lexer.h"
 #include "scene/pbrt_params.h"
 
@@ -32,17 +33,10 @@ typedef struct cdl_pbrt_gstate {
     char file[1024];
 } cdl_pbrt_gstate;
 
-/* A shape in object space, validated (pbrt_shapes.c). */
-typedef struct cdl_pbrt_mesh {
-    uint32_t nv, nt;
-    float *p, *n, *uv; /* n, uv may be NULL */
-    uint32_t *idx;
-} cdl_pbrt_mesh;
-
 typedef struct cdl_pbrt_shape {
     int sphere;     /* 1: analytic sphere of this radius; 0: mesh */
     double radius;
-    cdl_pbrt_mesh mesh;
+    cdl_mesh mesh; /* in object space, validated */
 } cdl_pbrt_shape;
 
 typedef struct cdl_pbrt_inst_shape {

@@ -11,18 +11,13 @@
 #include <string.h>
 
 #include "scene/pbrt_internal.h"
+#include "scene/mesh.h"
 #include "scene/ply.h"
 
-#define SPHERE_NPHI 96
-#define SPHERE_NTHETA 48
-#define PI 3.14159265358979323846
 
 void cdl_pbrt_shape_free(cdl_pbrt_shape *sh)
 {
-    free(sh->mesh.p);
-    free(sh->mesh.n);
-    free(sh->mesh.uv);
-    free(sh->mesh.idx);
+    cdl_mesh_free(&sh->mesh);
     memset(sh, 0, sizeof *sh);
 }
 
@@ -31,23 +26,10 @@ static int oom(cdl_pbrt_ctx *c)
     return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
 }
 
-static int mesh_alloc(cdl_pbrt_ctx *c, cdl_pbrt_mesh *m, uint32_t nv, uint32_t nt, int has_n, int has_uv)
-{
-    m->nv = nv;
-    m->nt = nt;
-    m->p = malloc(sizeof(float) * 3 * (size_t)nv);
-    m->idx = malloc(sizeof(uint32_t) * 3 * (size_t)(nt ? nt : 1));
-    m->n = has_n ? malloc(sizeof(float) * 3 * (size_t)nv) : NULL;
-    m->uv = has_uv ? malloc(sizeof(float) * 2 * (size_t)nv) : NULL;
-    if (!m->p || !m->idx || (has_n && !m->n) || (has_uv && !m->uv))
-        return oom(c);
-    return 0;
-}
-
 /* trianglemesh (quads = 0) or pbrt-v4 bilinearmesh (quads = 1, split
  * into two triangles (p00, p10, p11), (p00, p11, p01) that keep the
  * patch's normal cross(dp/du, dp/dv)). */
-static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_pbrt_mesh *m)
+static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_mesh *m)
 {
     cdl_pbrt_params *ps = &c->ps;
     const char *what = quads ? "bilinearmesh" : "trianglemesh";
@@ -93,16 +75,16 @@ static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_pbrt_mesh *m)
     size_t nt = ni / per * (quads ? 2 : 1);
     if (nt >= UINT32_MAX / 4)
         return cdl_pbrt_error(c, c->line, "%s: too many triangles", what);
-    int rc = mesh_alloc(c, m, nv, (uint32_t)nt, N != NULL, UV != NULL);
+    int rc = cdl_mesh_alloc(m, nv, (uint32_t)nt, N != NULL, UV != NULL, c->file, c->line, c->err);
     if (rc)
         return rc;
     const double *pv = cdl_pbrt_nums(ps, P);
     for (size_t i = 0; i < 3 * (size_t)nv; i++)
-        m->p[i] = (float)pv[i];
+        m->pos[i] = (float)pv[i];
     if (N) {
         const double *nv3 = cdl_pbrt_nums(ps, N);
         for (size_t i = 0; i < 3 * (size_t)nv; i++)
-            m->n[i] = (float)nv3[i];
+            m->nrm[i] = (float)nv3[i];
     }
     if (UV) {
         const double *uv = cdl_pbrt_nums(ps, UV);
@@ -123,7 +105,7 @@ static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_pbrt_mesh *m)
     return 0;
 }
 
-static int read_ply(cdl_pbrt_ctx *c, cdl_pbrt_mesh *m)
+static int read_ply(cdl_pbrt_ctx *c, cdl_mesh *m)
 {
     const char *fn;
     char path[1024];
@@ -135,140 +117,11 @@ static int read_ply(cdl_pbrt_ctx *c, cdl_pbrt_mesh *m)
     cdl_pbrt_resolve(c, fn, path, sizeof path);
     if ((rc = cdl_pbrt_check_file(c, "plymesh file", path)))
         return rc;
-    cdl_ply_mesh ply;
-    memset(&ply, 0, sizeof ply);
-    if ((rc = cdl_ply_read(path, &ply, c->err)))
-        return rc; /* names the PLY file and its problem */
-    rc = mesh_alloc(c, m, ply.nverts, ply.ntris, ply.nrm != NULL, ply.uv != NULL);
-    if (!rc && (ply.nverts == 0 || ply.ntris == 0))
-        rc = cdl_pbrt_error(c, c->line, "plymesh \"%s\" has no triangles", path);
-    for (size_t i = 0; !rc && i < 3 * (size_t)ply.ntris; i++)
-        if (ply.idx[i] >= ply.nverts)
-            rc = cdl_pbrt_error(c, c->line, "plymesh \"%s\": vertex index %u out of range", path, ply.idx[i]);
-    for (size_t i = 0; !rc && i < 3 * (size_t)ply.nverts; i++)
-        if (!isfinite(ply.pos[i]) || fabsf(ply.pos[i]) > CDL_MAX_COORD || (ply.nrm && !isfinite(ply.nrm[i])))
-            rc = cdl_pbrt_error(c, c->line, "plymesh \"%s\": vertex %zu is not finite or beyond 1e20", path,
-                                i / 3);
-    if (!rc) {
-        memcpy(m->p, ply.pos, sizeof(float) * 3 * (size_t)ply.nverts);
-        memcpy(m->idx, ply.idx, sizeof(uint32_t) * 3 * (size_t)ply.ntris);
-        if (ply.nrm)
-            memcpy(m->n, ply.nrm, sizeof(float) * 3 * (size_t)ply.nverts);
-        if (ply.uv)
-            memcpy(m->uv, ply.uv, sizeof(float) * 2 * (size_t)ply.nverts);
-    }
-    cdl_ply_free(&ply);
-    return rc;
-}
-
-/* Object space, radius r; normals point outwards, or inwards when flip. */
-static int tessellate_sphere(cdl_pbrt_ctx *c, double r, int flip, cdl_pbrt_mesh *m)
-{
-    const int np = SPHERE_NPHI, nth = SPHERE_NTHETA;
-    int rc = mesh_alloc(c, m, (uint32_t)((np + 1) * (nth + 1)), (uint32_t)(2 * np * nth), 1, 1);
-    if (rc)
-        return rc;
-    float s = flip ? -1.0f : 1.0f;
-    for (int j = 0, v = 0; j <= nth; j++) {
-        double th = PI * j / nth;
-        /* exact poles: their fans degenerate and are dropped, not slivers */
-        double st = j == 0 || j == nth ? 0.0 : sin(th), ct = j == 0 ? 1.0 : j == nth ? -1.0 : cos(th);
-        for (int i = 0; i <= np; i++, v++) {
-            double ph = 2.0 * PI * i / np;
-            double n[3] = {st * cos(ph), st * sin(ph), ct};
-            for (int k = 0; k < 3; k++) {
-                m->p[3 * v + k] = (float)(r * n[k]);
-                m->n[3 * v + k] = s * (float)n[k];
-            }
-            /* pbrt's sphere (u, v): u = phi / 2pi, v = 0 at z = -r */
-            m->uv[2 * v] = (float)i / (float)np;
-            m->uv[2 * v + 1] = 1.0f - (float)j / (float)nth;
-        }
-    }
-    uint32_t *t = m->idx;
-    for (int j = 0; j < nth; j++)
-        for (int i = 0; i < np; i++) {
-            uint32_t v00 = (uint32_t)(j * (np + 1) + i), v01 = v00 + 1;
-            uint32_t v10 = v00 + (uint32_t)(np + 1), v11 = v10 + 1;
-            if (j < nth - 1)
-                *t++ = v00, *t++ = v10, *t++ = v11;
-            if (j > 0)
-                *t++ = v00, *t++ = v11, *t++ = v01;
-        }
-    m->nt = (uint32_t)((t - m->idx) / 3);
+    if ((rc = cdl_ply_read(path, m, c->err)))
+        return rc; /* names the PLY file and its problem; indices and numbers are checked */
+    if (m->nverts == 0 || m->ntris == 0)
+        return cdl_pbrt_error(c, c->line, "plymesh \"%s\" has no triangles", path);
     return 0;
-}
-
-static int same_point(const float *a, const float *b)
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
-}
-
-static int emit_mesh(cdl_pbrt_ctx *c, const cdl_pbrt_mesh *m, const cdl_mat4 *ctm, int reverse,
-                     uint32_t mat, int32_t emit)
-{
-    cdl_mat4 inv;
-    if (m->n && cdl_mat4_inverse(ctm, &inv))
-        return cdl_pbrt_error(c, c->line, "the shape's transform is singular");
-    float *p = malloc(sizeof(float) * 3 * (size_t)m->nv);
-    float *n = m->n ? malloc(sizeof(float) * 3 * (size_t)m->nv) : NULL;
-    if (!p || (m->n && !n)) {
-        free(p);
-        free(n);
-        return oom(c);
-    }
-    int rc = 0;
-    for (uint32_t i = 0; i < m->nv && !rc; i++) {
-        double in[3] = {m->p[3 * i], m->p[3 * i + 1], m->p[3 * i + 2]}, o[3];
-        cdl_mat4_point(ctm, in, o);
-        for (int k = 0; k < 3; k++) {
-            if (!isfinite(o[k]) || fabs(o[k]) > CDL_MAX_COORD)
-                rc = cdl_pbrt_error(c, c->line, "vertex %u is transformed to (%g, %g, %g): not finite or beyond 1e20",
-                                    i, o[0], o[1], o[2]);
-            p[3 * i + k] = (float)o[k];
-        }
-        if (n) {
-            double nin[3] = {m->n[3 * i], m->n[3 * i + 1], m->n[3 * i + 2]}, no[3];
-            cdl_mat4_normal(&inv, nin, no);
-            double l = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
-            for (int k = 0; k < 3; k++)
-                n[3 * i + k] = l > 0.0 && isfinite(l) ? (float)(no[k] / l) : 0.0f;
-        }
-    }
-    uint32_t first = 0;
-    if (!rc)
-        rc = cdl_pbrt_scene_rc(c, cdl_scene_add_vertices(c->s, m->nv, p, n, m->uv, &first, c->err));
-    int flip_all = reverse ^ cdl_mat4_swaps_handedness(ctm);
-    uint8_t flags = (uint8_t)((n ? CDL_TRI_HAS_N : 0) | (m->uv ? CDL_TRI_HAS_UV : 0));
-    for (uint32_t t = 0; t < m->nt && !rc; t++) {
-        uint32_t a = m->idx[3 * t], b = m->idx[3 * t + 1], d = m->idx[3 * t + 2];
-        int flip = flip_all;
-        const float *pa = p + 3 * (size_t)a, *pb = p + 3 * (size_t)b, *pd = p + 3 * (size_t)d;
-        /* two equal corners: no area (the scene's cross-product test can
-         * miss this when the compiler contracts it into FMAs) */
-        if (same_point(pa, pb) || same_point(pb, pd) || same_point(pa, pd))
-            continue;
-        if (n) {
-            cdl_vec3 e1 = cdl_v3(pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]);
-            cdl_vec3 e2 = cdl_v3(pd[0] - pa[0], pd[1] - pa[1], pd[2] - pa[2]);
-            cdl_vec3 s = cdl_v3(0, 0, 0);
-            for (int k = 0; k < 3; k++) {
-                const float *nk = n + 3 * (size_t)m->idx[3 * t + k];
-                s = cdl_add(s, cdl_v3(nk[0], nk[1], nk[2]));
-            }
-            flip = cdl_dot(cdl_cross(e1, e2), s) < 0.0f;
-        }
-        if (flip) {
-            uint32_t tmp = b;
-            b = d;
-            d = tmp;
-        }
-        rc = cdl_pbrt_scene_rc(c, cdl_scene_add_triangle(c->s, first + a, first + b, first + d, mat, emit,
-                                                         flags, c->err));
-    }
-    free(p);
-    free(n);
-    return rc;
 }
 
 /* swap_def: the handedness of the transform the sphere was defined
@@ -278,7 +131,7 @@ static int emit_shape(cdl_pbrt_ctx *c, const cdl_pbrt_shape *sh, const cdl_mat4 
                       int swap_def, uint32_t mat, int32_t emit)
 {
     if (!sh->sphere)
-        return emit_mesh(c, &sh->mesh, ctm, reverse, mat, emit);
+        return cdl_scene_add_mesh(c->s, &sh->mesh, ctm, reverse, mat, emit, c->file, c->line, c->err);
     double scale;
     int inward = reverse ^ swap_def;
     if (cdl_mat4_is_similarity(ctm, 1e-4, &scale)) {
@@ -286,13 +139,12 @@ static int emit_shape(cdl_pbrt_ctx *c, const cdl_pbrt_shape *sh, const cdl_mat4 
         return cdl_pbrt_scene_rc(c, cdl_scene_add_sphere(c->s, ctr, (float)(sh->radius * scale), mat, emit,
                                                          inward, c->err));
     }
-    cdl_pbrt_mesh m;
+    cdl_mesh m;
     memset(&m, 0, sizeof m);
-    int rc = tessellate_sphere(c, sh->radius, inward, &m);
+    int rc = cdl_mesh_sphere(&m, sh->radius, inward, c->file, c->line, c->err);
     if (!rc)
-        rc = emit_mesh(c, &m, ctm, reverse, mat, emit);
-    cdl_pbrt_shape sh2 = {0, 0.0, m};
-    cdl_pbrt_shape_free(&sh2);
+        rc = cdl_scene_add_mesh(c->s, &m, ctm, reverse, mat, emit, c->file, c->line, c->err);
+    cdl_mesh_free(&m);
     return rc;
 }
 

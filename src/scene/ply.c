@@ -18,13 +18,8 @@
 
 void cdl_ply_free(cdl_ply_mesh *m)
 {
-    if (!m)
-        return;
-    free(m->pos);
-    free(m->nrm);
-    free(m->uv);
-    free(m->idx);
-    memset(m, 0, sizeof *m);
+    if (m)
+        cdl_mesh_free(m);
 }
 
 /* ---- file ---------------------------------------------------------------------------------- */

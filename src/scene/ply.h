@@ -18,14 +18,9 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "scene/mesh.h"
 
-typedef struct cdl_ply_mesh {
-    uint32_t nverts, ntris;
-    float *pos;    /* 3 per vertex */
-    float *nrm;    /* 3 per vertex, or NULL when the file has no nx ny nz */
-    float *uv;     /* 2 per vertex, or NULL (u v, s t, texture_u texture_v, texture_s texture_t) */
-    uint32_t *idx; /* 3 per triangle; polygons with n > 3 vertices are fan-triangulated */
-} cdl_ply_mesh;
+typedef cdl_mesh cdl_ply_mesh; /* polygons with n > 3 vertices are fan-triangulated */
 
 /* Fills m (all fields zero on failure). A file without faces is an error.
  * Every stored number is finite with |x| <= CDL_MAX_COORD and every index

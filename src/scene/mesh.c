@@ -1,0 +1,163 @@
+/* Mesh insertion as pbrt-v3 orients triangles: area lights emit from the
+ * front face only, so the orientation rule decides what a scene shows. */
+#define _POSIX_C_SOURCE 200809L
+#include "scene/mesh.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SPHERE_NPHI 96
+#define SPHERE_NTHETA 48
+#define PI 3.14159265358979323846
+
+int cdl_mesh_alloc(cdl_mesh *m, uint32_t nverts, uint32_t ntris, int has_n, int has_uv, const char *file,
+                   int line, cdl_error *err)
+{
+    memset(m, 0, sizeof *m);
+    m->nverts = nverts;
+    m->ntris = ntris;
+    m->pos = malloc(sizeof(float) * 3 * (size_t)(nverts ? nverts : 1));
+    m->idx = malloc(sizeof(uint32_t) * 3 * (size_t)(ntris ? ntris : 1));
+    m->nrm = has_n ? malloc(sizeof(float) * 3 * (size_t)(nverts ? nverts : 1)) : NULL;
+    m->uv = has_uv ? malloc(sizeof(float) * 2 * (size_t)(nverts ? nverts : 1)) : NULL;
+    if (!m->pos || !m->idx || (has_n && !m->nrm) || (has_uv && !m->uv)) {
+        cdl_mesh_free(m);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, file, line, "out of memory");
+    }
+    return 0;
+}
+
+void cdl_mesh_free(cdl_mesh *m)
+{
+    free(m->pos);
+    free(m->nrm);
+    free(m->uv);
+    free(m->idx);
+    memset(m, 0, sizeof *m);
+}
+
+int cdl_mesh_sphere(cdl_mesh *m, double r, int flip, const char *file, int line, cdl_error *err)
+{
+    const int np = SPHERE_NPHI, nth = SPHERE_NTHETA;
+    int rc = cdl_mesh_alloc(m, (uint32_t)((np + 1) * (nth + 1)), (uint32_t)(2 * np * nth), 1, 1, file, line, err);
+    if (rc)
+        return rc;
+    float s = flip ? -1.0f : 1.0f;
+    for (int j = 0, v = 0; j <= nth; j++) {
+        double th = PI * j / nth;
+        /* exact poles: their fans degenerate and are dropped, not slivers */
+        double st = j == 0 || j == nth ? 0.0 : sin(th), ct = j == 0 ? 1.0 : j == nth ? -1.0 : cos(th);
+        for (int i = 0; i <= np; i++, v++) {
+            double ph = 2.0 * PI * i / np;
+            double n[3] = {st * cos(ph), st * sin(ph), ct};
+            for (int k = 0; k < 3; k++) {
+                m->pos[3 * v + k] = (float)(r * n[k]);
+                m->nrm[3 * v + k] = s * (float)n[k];
+            }
+            /* pbrt's sphere (u, v): u = phi / 2pi, v = 0 at z = -r */
+            m->uv[2 * v] = (float)i / (float)np;
+            m->uv[2 * v + 1] = 1.0f - (float)j / (float)nth;
+        }
+    }
+    uint32_t *t = m->idx;
+    for (int j = 0; j < nth; j++)
+        for (int i = 0; i < np; i++) {
+            uint32_t v00 = (uint32_t)(j * (np + 1) + i), v01 = v00 + 1;
+            uint32_t v10 = v00 + (uint32_t)(np + 1), v11 = v10 + 1;
+            if (j < nth - 1)
+                *t++ = v00, *t++ = v10, *t++ = v11;
+            if (j > 0)
+                *t++ = v00, *t++ = v11, *t++ = v01;
+        }
+    m->ntris = (uint32_t)((t - m->idx) / 3);
+    return 0;
+}
+
+static int same_point(const float *a, const float *b)
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+/* Scene calls name the scene without a line; the shape's place is more useful. */
+static int placed(cdl_scene *s, int rc, const char *file, int line, cdl_error *err)
+{
+    if (rc && err && err->code == CDL_ERR_INPUT && err->line == 0 && !strcmp(err->file, s->path)) {
+        snprintf(err->file, sizeof err->file, "%s", file);
+        err->line = line;
+    }
+    return rc;
+}
+
+int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int reverse, uint32_t mat,
+                       int32_t emit, const char *file, int line, cdl_error *err)
+{
+    cdl_mat4 inv;
+    if (m->nrm && cdl_mat4_inverse(xf, &inv))
+        return cdl_error_set(err, CDL_ERR_INPUT, file, line, "the shape's transform is singular");
+    float *p = malloc(sizeof(float) * 3 * (size_t)(m->nverts ? m->nverts : 1));
+    float *n = m->nrm ? malloc(sizeof(float) * 3 * (size_t)(m->nverts ? m->nverts : 1)) : NULL;
+    if (!p || (m->nrm && !n)) {
+        free(p);
+        free(n);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, file, line, "out of memory");
+    }
+    int rc = 0;
+    for (uint32_t i = 0; i < m->nverts && !rc; i++) {
+        double in[3] = {m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]}, o[3];
+        cdl_mat4_point(xf, in, o);
+        for (int k = 0; k < 3; k++) {
+            if (!isfinite(o[k]) || fabs(o[k]) > CDL_MAX_COORD)
+                rc = cdl_error_set(err, CDL_ERR_INPUT, file, line,
+                                   "vertex %u is transformed to (%g, %g, %g): not finite or beyond 1e20", i, o[0],
+                                   o[1], o[2]);
+            p[3 * i + k] = (float)o[k];
+        }
+        if (n) {
+            double nin[3] = {m->nrm[3 * i], m->nrm[3 * i + 1], m->nrm[3 * i + 2]}, no[3];
+            cdl_mat4_normal(&inv, nin, no);
+            double l = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
+            for (int k = 0; k < 3; k++)
+                n[3 * i + k] = l > 0.0 && isfinite(l) ? (float)(no[k] / l) : 0.0f;
+        }
+    }
+    uint32_t first = 0;
+    if (!rc)
+        rc = placed(s, cdl_scene_add_vertices(s, m->nverts, p, n, m->uv, &first, err), file, line, err);
+    int flip_all = reverse ^ cdl_mat4_swaps_handedness(xf);
+    uint8_t flags = (uint8_t)((n ? CDL_TRI_HAS_N : 0) | (m->uv ? CDL_TRI_HAS_UV : 0));
+    for (uint32_t t = 0; t < m->ntris && !rc; t++) {
+        uint32_t a = m->idx[3 * t], b = m->idx[3 * t + 1], d = m->idx[3 * t + 2];
+        if (a >= m->nverts || b >= m->nverts || d >= m->nverts) {
+            rc = cdl_error_set(err, CDL_ERR_INPUT, file, line, "triangle %u: vertex index out of range", t);
+            break;
+        }
+        int flip = flip_all;
+        const float *pa = p + 3 * (size_t)a, *pb = p + 3 * (size_t)b, *pd = p + 3 * (size_t)d;
+        /* two equal corners: no area (the scene's cross-product test can
+         * miss this when the compiler contracts it into FMAs) */
+        if (same_point(pa, pb) || same_point(pb, pd) || same_point(pa, pd))
+            continue;
+        if (n) {
+            cdl_vec3 e1 = cdl_v3(pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]);
+            cdl_vec3 e2 = cdl_v3(pd[0] - pa[0], pd[1] - pa[1], pd[2] - pa[2]);
+            cdl_vec3 sum = cdl_v3(0, 0, 0);
+            for (int k = 0; k < 3; k++) {
+                const float *nk = n + 3 * (size_t)m->idx[3 * t + k];
+                sum = cdl_add(sum, cdl_v3(nk[0], nk[1], nk[2]));
+            }
+            flip = cdl_dot(cdl_cross(e1, e2), sum) < 0.0f;
+        }
+        if (flip) {
+            uint32_t tmp = b;
+            b = d;
+            d = tmp;
+        }
+        rc = placed(s, cdl_scene_add_triangle(s, first + a, first + b, first + d, mat, emit, flags, err), file,
+                    line, err);
+    }
+    free(p);
+    free(n);
+    return rc;
+}

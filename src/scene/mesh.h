@@ -1,0 +1,38 @@
+/* A triangle mesh in its own space, as every mesh reader (PLY, Mitsuba's
+ * serialized, pbrt's trianglemesh, generated shapes) hands it over, and its
+ * insertion into the scene under a transform. */
+#ifndef CDL_MESH_H
+#define CDL_MESH_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/transform.h"
+#include "scene/scene.h"
+
+typedef struct cdl_mesh {
+    uint32_t nverts, ntris;
+    float *pos;    /* 3 per vertex */
+    float *nrm;    /* 3 per vertex, or NULL */
+    float *uv;     /* 2 per vertex, or NULL */
+    uint32_t *idx; /* 3 per triangle, each < nverts */
+} cdl_mesh;
+
+/* Allocates the arrays (nrm, uv only when asked); errors name file:line. */
+int cdl_mesh_alloc(cdl_mesh *m, uint32_t nverts, uint32_t ntris, int has_n, int has_uv, const char *file,
+                   int line, cdl_error *err);
+/* Frees the arrays and zeroes m; safe on a zeroed or freed mesh. */
+void cdl_mesh_free(cdl_mesh *m);
+
+/* A sphere of radius r about the origin, normals outwards (inwards when
+ * flip), pbrt's (u, v): for spheres a transform cannot keep analytic. */
+int cdl_mesh_sphere(cdl_mesh *m, double r, int flip, const char *file, int line, cdl_error *err);
+
+/* Adds m transformed by xf with pbrt-v3's orientation rule: a triangle
+ * faces its shading normals when the mesh has them, otherwise its CCW
+ * normal flipped by reverse XOR a handedness-swapping xf. Errors (a
+ * singular xf, vertices beyond CDL_MAX_COORD) name file:line. */
+int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int reverse, uint32_t mat,
+                       int32_t emit, const char *file, int line, cdl_error *err);
+
+#endif
