@@ -48,9 +48,12 @@ static int gkde_prepare(void *self, const cdl_scene *scene, const cdl_options *o
                              "gkde traces N light paths per step for all pixels: give a number");
     if (opt->interleave > 1)
         return cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0, "gkde does not interleave light paths");
-    s->n_light = opt->light_paths ? opt->light_paths : 100000;
+    s->n_light = opt->light_paths ? opt->light_paths : GKDE_LIGHT_PATHS;
     s->eye_paths = opt->gkde.eye_paths ? opt->gkde.eye_paths : 1;
-    s->M = opt->gkde.links ? opt->gkde.links : 10;
+    /* h is calibrated to M overlaps of N first-bounce footprints, so h^2 ~
+     * M / N and the normalization bias (§3) grows with it: M tied to N
+     * keeps h whatever the light paths, fewer paths trading noise only */
+    s->M = opt->gkde.links ? opt->gkde.links : gkde_default_links(s->n_light);
     s->h = opt->gkde.bandwidth;
     s->have_h = s->h > 0.0f;
     if (!scene->nlights)

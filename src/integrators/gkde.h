@@ -12,6 +12,8 @@
 #include "transport/gkde_link.h"
 #include "transport/subpath.h"
 
+#define GKDE_LIGHT_PATHS 50000 /* default light paths per step */
+#define GKDE_PATHS_PER_LINK 10000 /* default: one wanted link per this many light paths */
 #define SEG_MAX_DEPTH 10 /* at most 2^10 subtrees */
 #define SEG_MIN 256
 
@@ -72,6 +74,14 @@ typedef struct gkde_state {
     gkde_stats st;
     atomic_int *cancel; /* the film's, set by each pass */
 } gkde_state;
+
+/* --links by default: N / 10000 rounded, at least 1 (the report's M = 10
+ * at 100000 paths, 5 at the default 50000). */
+static inline uint32_t gkde_default_links(uint32_t n_light)
+{
+    uint32_t m = (n_light + GKDE_PATHS_PER_LINK / 2) / GKDE_PATHS_PER_LINK;
+    return m ? m : 1;
+}
 
 /* The eye vertex (store index) of point q. */
 static inline uint32_t gkde_point_vertex(const gkde_state *s, uint32_t q)

@@ -34,7 +34,7 @@ void cdl_options_default(cdl_options *o)
     o->pm.caustic_ratio = 1.0f;
     o->pm.shadow_rays = 4;
     o->gkde.eye_paths = 1;
-    o->gkde.links = 10;
+    o->gkde.links = 0; /* tied to the light paths (gkde.h) */
     o->gkde.footprint_cap = 2.0f;
     o->gkde.max_mib = 4096;
     o->splat.photons = 200000;

@@ -48,7 +48,7 @@ typedef enum {
 /* gkde: generalized kernel density estimation (Bekaert et al. 2003) */
 typedef struct cdl_gkde_options {
     uint32_t eye_paths;  /* eye paths per pixel and step */
-    uint32_t links;      /* M: unoccluded links wanted per eye vertex (§5) */
+    uint32_t links;      /* M: unoccluded links wanted per eye vertex (§5); 0: one per 10000 light paths */
     float bandwidth;     /* h of eq. 7; <= 0: calibrated in the first step */
     float footprint_cap; /* footprint radii at most this times the median first-bounce one; 0: none */
     uint32_t max_mib;    /* cap on the stored path vertices (MiB) */
