@@ -31,4 +31,5 @@ bdpt|--light-paths 256 --interleave 4
 pm|
 rigi|
 ir|
+gkde|
 EOT

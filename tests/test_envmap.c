@@ -37,6 +37,10 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
         opt->light_paths = 16;
         spp /= 4;
     }
+    if (!strcmp(integ, "gkde")) { /* a step traces its light paths and links every eye vertex */
+        opt->light_paths = 2000;
+        spp /= 4;
+    }
     if (!strcmp(integ, "bdpt-shared")) { /* shared light paths in 2 x 2 sets */
         opt->light_paths = 64;
         opt->interleave = 2;

@@ -20,6 +20,10 @@
  *    M first-bounce footprints (the expected count is pi N h^2 with eq. 7's
  *    radii, so h = sqrt(M / (pi N)) corrected twice by the measured count).
  *
+ * Lights at infinity: their light paths start on a disk (the shared
+ * tracer), no surface point, so no footprint has x_0 there; their direct
+ * light is sampled at every eye vertex instead (cdl_gkde_sky).
+ *
  * Determinism whatever the thread count: the eye vertices are split into
  * kd subtrees that one thread owns, and each subtree meets the footprints
  * in light-vertex order, so sums and the stratified draws never depend on
@@ -31,6 +35,7 @@
 
 #include "core/log.h"
 #include "core/morton.h"
+#include "core/rng.h"
 #include "integrators/gkde.h"
 
 #define LIGHT_CHUNK 1024
@@ -43,6 +48,7 @@ static int gkde_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     s->opt = *opt;
     s->walk.maxdepth = opt->maxdepth;
     s->walk.rr_depth = opt->rr_depth;
+    s->walk.env_vertex = 1; /* eye paths that see the sky: its emission, weighted */
     if (opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE)
         return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0,
                              "gkde traces N light paths per step for all pixels: give a number");
@@ -59,9 +65,7 @@ static int gkde_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     if (!scene->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0, "gkde: the scene has no lights");
     for (uint32_t i = 0; i < scene->nlights; i++)
-        if (cdl_light_at_infinity(&scene->lights[i]))
-            return cdl_error_set(err, CDL_ERR_INPUT, scene->path, 0,
-                                 "gkde does not support distant or infinite lights yet");
+        s->at_infinity |= cdl_light_at_infinity(&scene->lights[i]);
     size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;
     s->pv = calloc(npix * 6, sizeof *s->pv);
     s->pixsum = malloc(npix * sizeof *s->pixsum);
@@ -271,8 +275,10 @@ static int footprints(gkde_state *s, float h, cdl_error *err)
     for (uint32_t i = 0; i < l->n; i++) {
         int32_t p = l->parent[i];
         r[i] = p < 0 ? 0.0f : cdl_footprint_radius(h, l->pdf_fwd[i], r[p], s->r_cap);
-        if (p >= 0 && !(l->flags[p] & CDL_V_DELTA) && l->depth[i] <= s->opt.maxdepth && r[i] > 0.0f &&
-            isfinite(r[i]))
+        /* a parent on the disk of a light at infinity is no surface point:
+         * light sampling at the eye vertices takes that direct light */
+        if (p >= 0 && !(l->flags[p] & (CDL_V_DELTA | CDL_V_INFINITE)) && l->depth[i] <= s->opt.maxdepth &&
+            r[i] > 0.0f && isfinite(r[i]))
             lv[s->nlv++] = i;
     }
     return sort_spatially(s, err);
@@ -348,6 +354,28 @@ static float cap_unit(const gkde_state *s)
 }
 
 
+/* Direct light from every light at infinity at every eye point: one light
+ * sample each (a hash of seed, pass and vertex: the same whatever the
+ * thread count), weighted against the merges and the eye path. */
+static uint64_t sky_light(gkde_state *s, uint32_t pass)
+{
+    const cdl_scene *sc = s->scene;
+    uint64_t rays = 0;
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : rays)
+    for (uint32_t q = 0; q < s->npts; q++) {
+        const cdl_gkde_eye *ye = &s->eye[q];
+        cdl_rng rng;
+        cdl_rng_seed(&rng, cdl_mix64(s->opt.seed ^ 0x6a09e667f3bcc909ULL ^ ((uint64_t)pass << 32)), ye->y);
+        for (uint32_t i = 0; i < sc->nlights; i++) {
+            if (!cdl_light_at_infinity(&sc->lights[i]))
+                continue;
+            float u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
+            s->acc[q] = cdl_add(s->acc[q], cdl_gkde_sky(&s->g, ye, i, u1, u2, &rays));
+        }
+    }
+    return rays;
+}
+
 static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     gkde_state *s = self;
@@ -385,6 +413,8 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     if (lr == UINT64_MAX)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory for candidate links");
     film->rays += lr;
+    if (s->at_infinity)
+        film->rays += sky_light(s, pass);
     rc = check_memory(s, err);
     if (rc)
         return rc;

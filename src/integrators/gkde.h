@@ -39,6 +39,7 @@ typedef struct gkde_state {
     uint32_t n_light, eye_paths, M;
     float h, r_cap;
     int have_h;
+    int at_infinity; /* the scene has distant or infinite lights */
     cdl_vertex_store lvs, evs;
     cdl_vertex_store *chunks; /* per row (eye) or per LIGHT_CHUNK paths (light), reused */
     uint32_t **chunk_pix;

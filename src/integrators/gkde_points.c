@@ -88,7 +88,7 @@ int gkde_build_points(gkde_state *s, cdl_error *err)
     const cdl_vertex_store *e = &s->evs;
     uint32_t n = 0;
     for (uint32_t i = 0; i < e->n; i++)
-        n += !(e->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA)) && e->depth[i] <= s->opt.maxdepth;
+        n += !(e->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA | CDL_V_INFINITE)) && e->depth[i] <= s->opt.maxdepth;
     if (n >= RANGE)
         return cdl_error_set(err, CDL_ERR_USAGE, "gkde", 0, "%u eye vertices: more than 2^31 per step", n);
     float *pts = malloc(sizeof(float) * 4 * (n ? n : 1));
@@ -96,7 +96,7 @@ int gkde_build_points(gkde_state *s, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
     n = 0;
     for (uint32_t i = 0; i < e->n; i++) {
-        if ((e->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA)) || e->depth[i] > s->opt.maxdepth)
+        if ((e->flags[i] & (CDL_V_CAMERA | CDL_V_DELTA | CDL_V_INFINITE)) || e->depth[i] > s->opt.maxdepth)
             continue;
         pts[4 * (size_t)n] = e->p[i].x;
         pts[4 * (size_t)n + 1] = e->p[i].y;

@@ -10,8 +10,24 @@ typedef struct path_pdfs {
     float pe[MAX_PATH]; /* area density of z_i sampled from the eye side */
     uint8_t delta[MAX_PATH];
     int n;
-    int s0; /* the eye path alone can sample it (z_0 on an area light) */
+    int s0;    /* the eye path alone can sample it (z_0 on an area light or the sky) */
+    int inf;   /* z_0 at infinity: no merge at z_1 (x_0 on the disk is no surface
+                * point), light sampling at z_1 instead */
+    float pls; /* that light sample's solid-angle density of z_0's direction */
 } path_pdfs;
+
+/* z_0 on light li at infinity, seen along w from z_1: pl_0 the light
+ * path's density of that start (light choice times direction, solid angle
+ * as in bdpt) and pls light sampling's (every light at infinity sampled
+ * once per eye vertex); a distant light's Dirac direction cancels in both. */
+static void infinite_start(const cdl_scene *s, int32_t li, cdl_vec3 w, path_pdfs *pp)
+{
+    const cdl_light *l = &s->lights[li];
+    pp->inf = 1;
+    pp->pls = l->type == CDL_LIGHT_DISTANT ? 1.0f : cdl_light_pdf_li(l, cdl_v3(0, 0, 0), w, INFINITY);
+    pp->pl[0] = s->light_select.pmf[li] * pp->pls;
+    pp->delta[0] = 0;
+}
 
 static cdl_vec3 point_normal(const cdl_vertex_store *vs, uint32_t i)
 {
@@ -48,6 +64,10 @@ static float weight_log(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
         r = cdl_footprint_radius(g->h, pp->pl[j], r, g->r_cap);
         ok[j] = !pp->delta[j] && !pp->delta[j - 1] && r > 0.0f;
         ld[j] = lpl + lsum_pe[j] + lnpi + 2.0 * log((double)r);
+        if (j == 1 && pp->inf) { /* light sampling at z_1 */
+            ok[j] = !pp->delta[1];
+            ld[j] = log1(pp->pls) + lsum_pe[1];
+        }
         if (ok[j] && ld[j] > best)
             best = ld[j];
     }
@@ -73,9 +93,10 @@ static float weight(const cdl_gkde_ctx *g, const path_pdfs *pp, int cur)
     for (int j = 1; j < n; j++) {
         b *= j == 1 ? nz(pp->pl[0]) * nz(pp->pl[1]) / nz(pp->pe[0]) : nz(pp->pl[j]) / nz(pp->pe[j - 1]);
         r = cdl_footprint_radius(g->h, pp->pl[j], r, g->r_cap);
-        if (pp->delta[j] || pp->delta[j - 1] || !(r > 0.0f))
+        int ls = j == 1 && pp->inf; /* light sampling at z_1 */
+        if (pp->delta[j] || (!ls && (pp->delta[j - 1] || !(r > 0.0f))))
             continue;
-        double d = b * npi * (double)r * (double)r;
+        double d = ls ? nz(pp->pls) / nz(pp->pe[0]) : b * npi * (double)r * (double)r;
         sum += d;
         if (j == cur)
             dcur = d;
@@ -153,7 +174,7 @@ void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *p
     const cdl_vertex_store *lvs = g->lvs;
     int32_t xp = lvs->parent[xk];
     par->xk = xk;
-    par->ok = xp >= 0 && !(lvs->flags[xp] & CDL_V_DELTA);
+    par->ok = xp >= 0 && !(lvs->flags[xp] & (CDL_V_DELTA | CDL_V_INFINITE));
     if (!par->ok)
         return;
     vertex_init(g, lvs, (uint32_t)xp, &par->xp);
@@ -244,20 +265,26 @@ float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, co
     int k = lvs->depth[xp] + 1;
     if (!fill_eye_rec(g, ye, k, &pp))
         return 0.0f;
-    int32_t v = (int32_t)xp, x0 = v;
+    int32_t v = (int32_t)xp, x0 = v, x1 = v;
     for (int i = k - 1; i >= 0; i--, v = lvs->parent[v]) {
         pp.pl[i] = lvs->pdf_fwd[v];
         pp.pe[i] = lvs->pdf_rev[v];
         pp.delta[i] = i > 0 && (lvs->flags[v] & CDL_V_DELTA) != 0;
+        x1 = x0;
         x0 = v;
     }
     pp.s0 = !(lvs->flags[x0] & CDL_V_DELTA_LIGHT);
+    pp.inf = 0;
+    if (lvs->flags[x0] & CDL_V_INFINITE)
+        infinite_start(g->cx.scene, lvs->light[x0], lvs->wi[x1], &pp);
     /* densities through the new edge x_{k-1} -> y, both ways */
     pp.pl[k] = cdl_pdf_to_area(ls->p_sa, px, py, ye->b.ng);
     if (k + 1 < pp.n)
         pp.pl[k + 1] = eye_pdf(ye, px, ye->to, ye->to_n);
     pp.pe[k - 1] = eye_pdf(ye, ye->to, px, point_normal(lvs, xp));
-    if (k >= 2)
+    if (k == 2 && pp.inf) /* x_1 sampling the direction to x_0: solid angle */
+        pp.pe[0] = cdl_vertex_pdf_sa_bsdf(&g->cx, lvs, xp, &par->xp.b, py, lvs->wi[xp]);
+    else if (k >= 2)
         pp.pe[k - 2] = vertex_pdf(g, &par->xp, py, par->from, point_normal(lvs, (uint32_t)par->xpp));
     return weight(g, &pp, k);
 }
@@ -269,7 +296,8 @@ cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y)
     if (!(evs->flags[y] & CDL_V_EMITTER) || evs->light[y] < 0)
         return zero;
     const cdl_light *l = &g->cx.scene->lights[evs->light[y]];
-    cdl_vec3 Le = cdl_light_Le(l, evs->ng[y], evs->wi[y]);
+    int inf = (evs->flags[y] & CDL_V_INFINITE) != 0; /* the eye path left the scene */
+    cdl_vec3 Le = inf ? cdl_light_env_Le(l, cdl_neg(evs->wi[y])) : cdl_light_Le(l, evs->ng[y], evs->wi[y]);
     if (cdl_is_black(Le))
         return zero;
     cdl_vec3 c = cdl_mul(evs->beta[y], Le);
@@ -280,9 +308,48 @@ cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y)
         return c; /* seen directly: nothing else samples it */
     pp.s0 = 1;
     pp.delta[0] = 0;
-    pp.pl[0] = cdl_light_pdf_origin(g->cx.scene, evs->light[y]);
+    pp.inf = 0;
     int32_t z1 = evs->parent[y];
-    pp.pl[1] = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[y], evs->wi[y]), evs->p[y], evs->p[z1],
-                               point_normal(evs, (uint32_t)z1));
+    if (inf) {
+        infinite_start(g->cx.scene, evs->light[y], cdl_neg(evs->wi[y]), &pp);
+        pp.pl[1] = cdl_light_pdf_disk(l, evs->wi[y], evs->ng[z1]);
+    } else {
+        pp.pl[0] = cdl_light_pdf_origin(g->cx.scene, evs->light[y]);
+        pp.pl[1] = cdl_pdf_to_area(cdl_light_pdf_dir(l, evs->ng[y], evs->wi[y]), evs->p[y], evs->p[z1],
+                                   point_normal(evs, (uint32_t)z1));
+    }
     return cdl_scale(c, weight(g, &pp, 0));
+}
+
+cdl_vec3 cdl_gkde_sky(const cdl_gkde_ctx *g, const cdl_gkde_eye *ye, uint32_t li, float u1, float u2,
+                      uint64_t *rays)
+{
+    const cdl_scene *s = g->cx.scene;
+    const cdl_light *l = &s->lights[li];
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    cdl_light_sample ls;
+    if (!cdl_light_sample_li(l, ye->p, u1, u2, &ls) || !(ls.pdf > 0.0f))
+        return zero;
+    cdl_vec3 wo = cdl_normalize(cdl_sub(ye->to, ye->p));
+    cdl_vec3 f = cdl_bsdf_eval(&ye->b, wo, ls.wi, 0);
+    if (cdl_is_black(f))
+        return zero;
+    /* the path z_0 (at infinity), z_1 = y, ..., y_1 */
+    path_pdfs pp;
+    if (!fill_eye_rec(g, ye, 1, &pp))
+        return zero;
+    pp.s0 = !cdl_light_is_delta(l);
+    infinite_start(s, (int32_t)li, ls.wi, &pp);
+    pp.pe[0] = cdl_bsdf_pdf(&ye->b, wo, ls.wi);
+    pp.pl[1] = cdl_light_pdf_disk(l, ls.wi, ye->b.ng);
+    if (pp.n > 2)
+        pp.pl[2] = eye_pdf(ye, cdl_add(ye->p, ls.wi), ye->to, ye->to_n);
+    float w = weight(g, &pp, 1);
+    if (!(w > 0.0f))
+        return zero;
+    (*rays)++;
+    if (!cdl_light_sample_visible(s, l, ye->p, ye->b.ng, &ls))
+        return zero;
+    float cos = fabsf(cdl_dot(ls.wi, ye->ns));
+    return cdl_scale(cdl_mul(cdl_mul(f, ls.Li), ye->beta), w * cos / ls.pdf);
 }

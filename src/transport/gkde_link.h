@@ -123,4 +123,12 @@ float cdl_gkde_link_weight(const cdl_gkde_ctx *g, const cdl_gkde_parent *par, co
  * alone), times its weight against the merges of the same path. */
 cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y);
 
+/* Direct light at eye vertex y from light li at infinity: one light
+ * sample (u1, u2) and its shadow ray, weighted against the eye path
+ * hitting the sky and the merges at later vertices (the merge at y would
+ * need x_0 on the light's disk, no surface point: this strategy replaces
+ * it). */
+cdl_vec3 cdl_gkde_sky(const cdl_gkde_ctx *g, const cdl_gkde_eye *ye, uint32_t li, float u1, float u2,
+                      uint64_t *rays);
+
 #endif
