@@ -96,10 +96,13 @@ int cdl_envmap_init(cdl_envmap *m, int w, int h, float *rgb, const cdl_vec3 fram
     m->h = h;
     m->equal_area = equal_area;
     m->rgb = rgb;
-    /* a right-handed orthonormal frame from the transform's axes */
+    /* an orthonormal frame from the transform's axes, keeping a mirror's
+     * handedness (Mitsuba's lat-long map is pbrt's mirrored) */
     m->ez = cdl_normalize(frame[2]);
     m->ex = cdl_normalize(cdl_sub(frame[0], cdl_scale(m->ez, cdl_dot(frame[0], m->ez))));
     m->ey = cdl_cross(m->ez, m->ex);
+    if (cdl_dot(m->ey, frame[1]) < 0.0f)
+        m->ey = cdl_scale(m->ey, -1.0f);
     if (!cdl_is_finite3(m->ex) || !cdl_is_finite3(m->ez) || !(cdl_length(m->ex) > 0.5f)) {
         m->rgb = NULL;
         return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "environment map transform is degenerate");

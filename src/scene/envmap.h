@@ -26,7 +26,7 @@ typedef struct cdl_envmap {
 
 /* Reads path (EXR, PFM, PNG by content; Radiance .hdr by extension),
  * scaled by scale; frame: world images of the light's x, y, z axes
- * (orthonormalized here). */
+ * (orthonormalized here; a mirrored frame stays mirrored). */
 int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_vec3 frame[3], int equal_area,
                     cdl_error *err);
 /* A map from given texels (tests and generated maps); takes rgb over. */

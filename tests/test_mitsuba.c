@@ -1,0 +1,306 @@
+/* Mitsuba reader: camera frame and fov axes, transform order, defaults and
+ * $variables, include, camelCase (0.6) names, built-in shapes and their
+ * orientation, materials, emitters, and the environment map's orientation
+ * texel by texel; then the real scenes.
+ *
+ *   test_mitsuba [SHARED_SCENES_DIR]
+ *
+ * Writes small .xml files into a fresh temporary directory. The shared
+ * scenes (veach-mis, veach-bidir mitsuba3 and sponza mitsuba) are loaded
+ * and compared with their pbrt-v3 twins' cameras when present. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/log.h"
+#include "core/transform.h"
+#include "film/image.h"
+#include "scene/loader.h"
+#include "test_util.h"
+
+#define PI 3.14159265358979323846
+
+static char dir[200];
+
+static void write_file(const char *name, const char *text)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        perror(path);
+        exit(2);
+    }
+    fputs(text, f);
+    fclose(f);
+}
+
+static int load_path(const char *path, cdl_scene *s, cdl_scene_settings *set)
+{
+    cdl_error err;
+    int rc = cdl_scene_init(s, path, &err);
+    if (!rc)
+        rc = cdl_scene_load(s, path, set, &err);
+    if (!rc)
+        rc = cdl_scene_commit(s, &err);
+    if (rc) {
+        char buf[2048];
+        cdl_error_format(&err, buf, sizeof buf);
+        printf("      load %s: %s\n", path, buf);
+    }
+    return rc;
+}
+
+static int load(const char *name, cdl_scene *s, cdl_scene_settings *set)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return load_path(path, s, set);
+}
+
+static int near3(cdl_vec3 a, cdl_vec3 b, float tol)
+{
+    return fabsf(a.x - b.x) <= tol && fabsf(a.y - b.y) <= tol && fabsf(a.z - b.z) <= tol;
+}
+
+static cdl_vec3 unit(cdl_vec3 v)
+{
+    return cdl_scale(v, 1.0f / cdl_length(v));
+}
+
+#define LIGHT "<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"0\" z=\"9\"/></emitter>\n"
+
+/* lookat camera, fov along x on a wide film, $variables with defaults,
+ * and the transform order (scale, then translate). */
+static void camera_and_transforms(void)
+{
+    write_file("cam.xml", "<scene version=\"3.0.0\">\n"
+                          "<default name=\"w\" value=\"200\"/><default name=\"w\" value=\"999\"/>\n"
+                          "<sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/>\n"
+                          "<transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>"
+                          "</transform>\n"
+                          "<sampler type=\"independent\"><integer name=\"sample_count\" value=\"7\"/></sampler>\n"
+                          "<film type=\"hdrfilm\"><integer name=\"width\" value=\"$w\"/>"
+                          "<integer name=\"height\" value=\"100\"/></film></sensor>\n"
+                          "<integrator type=\"bdpt\"><integer name=\"max_depth\" value=\"5\"/></integrator>\n" LIGHT
+                          "<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"2\"/>"
+                          "<translate x=\"10\"/></transform></shape>\n"
+                          "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("cam.xml", &s, &set)) {
+        CHECK(0, "cam.xml loads");
+        return;
+    }
+    double want = 2.0 * atan(tan(30.0 * PI / 180.0) * 100.0 / 200.0) * 180.0 / PI;
+    CHECK(set.has_camera && near3(set.eye, cdl_v3(0, 0, 5), 1e-6f) && near3(unit(set.fwd), cdl_v3(0, 0, -1), 1e-6f) &&
+              near3(unit(set.up), cdl_v3(0, 1, 0), 1e-6f) && near3(unit(set.right), cdl_v3(1, 0, 0), 1e-6f),
+          "lookat: eye (%g %g %g), fwd (%g %g %g), right (%g %g %g) = +x (Mitsuba's +x is the image's left)",
+          (double)set.eye.x, (double)set.eye.y, (double)set.eye.z, (double)set.fwd.x, (double)set.fwd.y,
+          (double)set.fwd.z, (double)set.right.x, (double)set.right.y, (double)set.right.z);
+    CHECK(fabs(set.fov - want) < 1e-4, "fov 60 along x on 200 x 100 is %.4f on the short axis (%.4f)", (double)set.fov,
+          want);
+    CHECK(set.width == 200 && set.height == 100 && set.spp == 7, "film $w = 200 (first default wins), 100, 7 spp");
+    CHECK(!strcmp(set.integrator, "bdpt") && set.maxdepth == 4, "bdpt, max_depth 5 = maxdepth %d (4 bounces)",
+          set.maxdepth);
+    float xmin = 1e30f, xmax = -1e30f;
+    for (uint32_t i = 0; i < s.nverts; i++)
+        xmin = fminf(xmin, s.pos[3 * i]), xmax = fmaxf(xmax, s.pos[3 * i]);
+    CHECK(s.ntris == 2 && xmin == 8.0f && xmax == 12.0f, "scale 2 then translate 10: x in [%g, %g] (8, 12)",
+          (double)xmin, (double)xmax);
+    cdl_scene_free(&s);
+}
+
+/* Mitsuba 0.6 spelling (toWorld, intIOR, specularReflectance), include,
+ * refs, the default bsdf, materials and emitters. */
+static void materials_and_include(void)
+{
+    write_file("inc.xml", "<scene version=\"0.6.0\">\n<bsdf type=\"roughconductor\" id=\"metal\">"
+                          "<string name=\"material\" value=\"Au\"/><float name=\"alpha\" value=\"0.2\"/>"
+                          "<rgb name=\"specularReflectance\" value=\"0.3\"/></bsdf>\n</scene>\n");
+    write_file("mat.xml",
+               "<scene version=\"0.6.0\">\n<include filename=\"inc.xml\"/>\n" LIGHT
+               "<shape type=\"cube\"><ref id=\"metal\"/></shape>\n"
+               "<shape type=\"cube\"><bsdf type=\"dielectric\"><float name=\"intIOR\" value=\"1.6\"/>"
+               "<float name=\"extIOR\" value=\"1.0\"/></bsdf></shape>\n"
+               "<shape type=\"disk\"><bsdf type=\"twosided\"><bsdf type=\"roughplastic\">"
+               "<rgb name=\"diffuseReflectance\" value=\"0.1, 0.2, 0.3\"/><string name=\"intIOR\" value=\"water\"/>"
+               "</bsdf></bsdf></shape>\n"
+               "<shape type=\"rectangle\"/>\n"
+               "<shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"2\" z=\"3\"/><float name=\"radius\" value=\"0.5\"/>"
+               "<transform name=\"toWorld\"><scale value=\"2\"/></transform>"
+               "<emitter type=\"area\"><spectrum name=\"radiance\" value=\"4\"/></emitter></shape>\n"
+               "<emitter type=\"spot\"><float name=\"cutoffAngle\" value=\"30\"/>"
+               "<transform name=\"toWorld\"><lookat origin=\"0,5,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>"
+               "</emitter>\n"
+               "<emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"-1\" z=\"0\"/>"
+               "<rgb name=\"irradiance\" value=\"3\"/></emitter>\n"
+               "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("mat.xml", &s, &set)) {
+        CHECK(0, "mat.xml loads");
+        return;
+    }
+    CHECK(s.nmats == 4, "%u materials: gold, glass, plastic, Mitsuba's default diffuse (rectangle and sphere)",
+          s.nmats);
+    const cdl_material *m = s.mats;
+    CHECK(m[0].type == CDL_MAT_CONDUCTOR && fabsf(m[0].alpha_x - 0.2f) < 1e-6f && fabsf(m[0].ks.x - 0.3f) < 1e-6f &&
+              fabsf(m[0].eta3.x - 0.1431f) < 1e-3f,
+          "included roughconductor Au, alpha 0.2, specularReflectance 0.3");
+    CHECK(m[1].type == CDL_MAT_DIELECTRIC && fabsf(m[1].eta - 1.6f) < 1e-6f, "dielectric intIOR/extIOR = %g",
+          (double)m[1].eta);
+    CHECK(m[2].type == CDL_MAT_PLASTIC && fabsf(m[2].eta - (float)(1.333 / 1.000277)) < 1e-4f &&
+              near3(m[2].kd, cdl_v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m[2].alpha_x - 0.1f) < 1e-6f,
+          "twosided roughplastic: water / air = %g, kd, alpha 0.1", (double)m[2].eta);
+    CHECK(m[3].type == CDL_MAT_DIFFUSE && near3(m[3].kd, cdl_v3(0.5f, 0.5f, 0.5f), 0.0f),
+          "a shape without bsdf gets diffuse 0.5");
+    CHECK(s.nspheres == 1 && near3(cdl_v3(s.sph[0], s.sph[1], s.sph[2]), cdl_v3(2, 4, 6), 1e-5f) &&
+              fabsf(s.sph[3] - 1.0f) < 1e-6f && s.sph_emit[0] >= 0 && s.emitters[s.sph_emit[0]].L.x == 4.0f,
+          "sphere center (1 2 3) r 0.5 under scale 2: (%g %g %g) r %g, emitting 4", (double)s.sph[0],
+          (double)s.sph[1], (double)s.sph[2], (double)s.sph[3]);
+    /* cube 12 + cube 12 + disk 128 + rectangle 2 */
+    CHECK(s.ntris == 154, "triangles: 2 cubes, a 128-segment disk, a rectangle = %u (154)", s.ntris);
+    /* every cube face's CCW normal points outwards */
+    int outward = 0;
+    for (uint32_t t = 0; t < 12; t++) {
+        const uint32_t *ix = s.idx + 3 * t;
+        cdl_vec3 a = cdl_v3(s.pos[3 * ix[0]], s.pos[3 * ix[0] + 1], s.pos[3 * ix[0] + 2]);
+        cdl_vec3 b = cdl_v3(s.pos[3 * ix[1]], s.pos[3 * ix[1] + 1], s.pos[3 * ix[1] + 2]);
+        cdl_vec3 c = cdl_v3(s.pos[3 * ix[2]], s.pos[3 * ix[2] + 1], s.pos[3 * ix[2] + 2]);
+        cdl_vec3 ctr = cdl_scale(cdl_add(cdl_add(a, b), c), 1.0f / 3.0f);
+        outward += cdl_dot(cdl_cross(cdl_sub(b, a), cdl_sub(c, a)), ctr) > 0.0f;
+    }
+    CHECK(outward == 12, "cube: %d of 12 triangles face outwards", outward);
+    int spot = -1, dist = -1;
+    for (uint32_t i = 0; i < s.nlights; i++) {
+        if (s.lights[i].type == CDL_LIGHT_SPOT)
+            spot = (int)i;
+        if (s.lights[i].type == CDL_LIGHT_DISTANT)
+            dist = (int)i;
+    }
+    CHECK(spot >= 0 && near3(s.lights[spot].p, cdl_v3(0, 5, 0), 1e-6f) &&
+              near3(unit(s.lights[spot].n), cdl_v3(0, -1, 0), 1e-6f),
+          "spot at (0 5 0) looking down its lookat");
+    CHECK(dist >= 0 && near3(unit(s.lights[dist].n), cdl_v3(0, -1, 0), 1e-6f) && s.lights[dist].L.y == 3.0f,
+          "directional light along -y, irradiance 3");
+    cdl_scene_free(&s);
+}
+
+/* Each texel of an 8 x 4 map is seen in Mitsuba's direction for it:
+ * local d = (sin phi sin theta, cos theta, -cos phi sin theta) with
+ * phi = 2 pi u, theta = pi v, turned by to_world. */
+static void envmap_orientation(void)
+{
+    cdl_image img;
+    cdl_error err;
+    die_on(cdl_image_alloc(&img, 8, 4, &err), &err);
+    for (int i = 0; i < 32; i++)
+        for (int c = 0; c < 3; c++)
+            img.rgb[3 * i + c] = (float)(i + 1);
+    char path[512];
+    snprintf(path, sizeof path, "%s/env.exr", dir);
+    die_on(cdl_image_write(path, &img, NULL, 0, 0.0f, &err), &err);
+    cdl_image_free(&img);
+    write_file("env.xml", "<scene version=\"3.0.0\">\n<emitter type=\"envmap\"><string name=\"filename\" value=\"env.exr\"/>"
+                          "<float name=\"scale\" value=\"2\"/><transform name=\"to_world\">"
+                          "<rotate x=\"1\" angle=\"90\"/></transform></emitter>\n"
+                          "<shape type=\"rectangle\"/>\n</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("env.xml", &s, &set) || !s.envmap) {
+        CHECK(0, "env.xml loads with a map");
+        return;
+    }
+    cdl_mat4 rot;
+    cdl_mat4_rotate(90.0, 1, 0, 0, &rot);
+    int good = 0;
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 8; x++) {
+            double phi = 2.0 * PI * (x + 0.5) / 8.0, th = PI * (y + 0.5) / 4.0;
+            cdl_vec3 d = cdl_v3((float)(sin(phi) * sin(th)), (float)cos(th), (float)(-cos(phi) * sin(th)));
+            cdl_vec3 L = cdl_envmap_eval(s.envmap, cdl_mat4_vector3(&rot, d));
+            good += fabsf(L.x - 2.0f * (float)(y * 8 + x + 1)) < 1e-4f;
+        }
+    CHECK(good == 32, "envmap: %d of 32 texels seen in Mitsuba's direction (turned by to_world), scaled by 2", good);
+    cdl_scene_free(&s);
+}
+
+/* The shared scenes: load, and the Veach scenes' cameras equal their
+ * pbrt-v3 twins'. */
+static void shared_scenes(const char *root)
+{
+    static const char *const twins[] = {"veach-mis", "veach-bidir"};
+    for (int i = 0; i < 2; i++) {
+        char mp[600], pp[600];
+        snprintf(mp, sizeof mp, "%s/%s/mitsuba3/scene.xml", root, twins[i]);
+        snprintf(pp, sizeof pp, "%s/%s/pbrt-v3/scene.pbrt", root, twins[i]);
+        if (access(mp, R_OK) || access(pp, R_OK)) {
+            printf("skip: %s (not in %s)\n", twins[i], root);
+            continue;
+        }
+        cdl_scene a, b;
+        cdl_scene_settings sa, sb;
+        if (load_path(mp, &a, &sa)) {
+            CHECK(0, "%s loads", mp);
+            continue;
+        }
+        if (load_path(pp, &b, &sb)) {
+            CHECK(0, "%s loads", pp);
+            cdl_scene_free(&a);
+            continue;
+        }
+        CHECK(near3(sa.eye, sb.eye, 1e-4f) && near3(unit(sa.fwd), unit(sb.fwd), 1e-5f) &&
+                  near3(unit(sa.up), unit(sb.up), 1e-5f) && near3(unit(sa.right), unit(sb.right), 1e-5f) &&
+                  fabsf(sa.fov - sb.fov) < 1e-3f && sa.width == sb.width && sa.height == sb.height,
+              "%s: Mitsuba camera = pbrt-v3 camera (fov %.4f vs %.4f, %dx%d)", twins[i], (double)sa.fov,
+              (double)sb.fov, sa.width, sa.height);
+        CHECK(sa.maxdepth == sb.maxdepth - 1, "%s: max_depth %d (Mitsuba) = maxdepth %d bounces; pbrt's file says %d",
+              twins[i], sa.maxdepth + 1, sa.maxdepth, sb.maxdepth);
+        CHECK(a.nlights == b.nlights, "%s: %u lights (pbrt twin %u)", twins[i], a.nlights, b.nlights);
+        CHECK(fabsf(a.bmin.x - b.bmin.x) < 1e-3f && fabsf(a.bmax.y - b.bmax.y) < 1e-3f &&
+                  fabsf(a.bmax.z - b.bmax.z) < 1e-3f,
+              "%s: same bounds", twins[i]);
+        cdl_scene_free(&a);
+        cdl_scene_free(&b);
+    }
+    char sp[600];
+    snprintf(sp, sizeof sp, "%s/sponza-dabrovic/mitsuba/sponza.xml", root);
+    if (access(sp, R_OK)) {
+        printf("skip: sponza (not in %s)\n", root);
+        return;
+    }
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load_path(sp, &s, &set)) {
+        CHECK(0, "sponza.xml loads");
+        return;
+    }
+    CHECK(s.ntris > 66000 && s.ntexs == 10 && s.nspheres == 1 && set.width == 768 && set.height == 575,
+          "sponza: %u triangles from 37 serialized shapes, %u textures, the sphere light, film %dx%d", s.ntris,
+          s.ntexs, set.width, set.height);
+    cdl_scene_free(&s);
+}
+
+int main(int argc, char **argv)
+{
+    snprintf(dir, sizeof dir, "/tmp/candela-mitsuba.XXXXXX");
+    if (!mkdtemp(dir)) {
+        perror("mkdtemp");
+        return 2;
+    }
+    camera_and_transforms();
+    materials_and_include();
+    envmap_orientation();
+    if (argc > 1)
+        shared_scenes(argv[1]);
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd)) {
+    }
+    printf("%s\n", test_failures ? "FAILED" : "all passed");
+    return test_failures != 0;
+}
