@@ -13,7 +13,7 @@ set -u
 build=$1 src=$2 secs=$3
 root=${4:-}
 shift $(( $# < 4 ? $# : 4 ))
-targets=${*:-obj pbrt ply image options}
+targets=${*:-obj pbrt ply image options mitsuba}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 export LSAN_OPTIONS="suppressions=$src/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
@@ -33,6 +33,8 @@ seed() { # seed TARGET DIR
     pbrt)
       cp "$src"/tests/bad_pbrt/*.pbrt "$d"/ 2>/dev/null
       find "$src/scenes" "$src/tests/data" -name '*.pbrt' -size -64k -exec cp {} "$d"/ \; 2>/dev/null ;;
+    mitsuba)
+      cp "$src"/tests/bad_mitsuba/*.xml "$d"/ 2>/dev/null ;;
     ply)
       cp "$src"/tests/bad_ply/*.ply "$d"/ 2>/dev/null
       find "$src/tests/data" "$src/../shared/scenes/veach-bidir" -name '*.ply' -size -64k -exec cp {} "$d"/ \; 2>/dev/null ;;

@@ -33,6 +33,17 @@ typedef struct cdl_material {
     char name[64];
 } cdl_material;
 
+/* Phong's sampling weight stays <= 1 only if kd + ks (n+2)/(n+1) <= 1 per
+ * channel: the factor (<= 1) that brings the worst channel there. */
+static inline float cdl_phong_energy_scale(const cdl_material *m)
+{
+    float lobe = (m->ns + 2.0f) / (m->ns + 1.0f);
+    float worst = m->kd.x + m->ks.x * lobe;
+    worst = worst > m->kd.y + m->ks.y * lobe ? worst : m->kd.y + m->ks.y * lobe;
+    worst = worst > m->kd.z + m->ks.z * lobe ? worst : m->kd.z + m->ks.z * lobe;
+    return worst > 1.0f ? 1.0f / worst : 1.0f;
+}
+
 /* A material with every field at its neutral default. */
 static inline cdl_material cdl_material_default(cdl_mat_type type)
 {

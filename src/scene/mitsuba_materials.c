@@ -259,13 +259,20 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
         m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
     } else if (!strcmp(type, "phong")) {
-        double e;
+        double e = 30.0;
         m = cdl_material_default(CDL_MAT_PHONG);
         if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
             !(rc = color(c, n, "specular_reflectance", cdl_v3(0.2f, 0.2f, 0.2f), &m.ks, NULL)) &&
             !(rc = cdl_mts_float(c, n, "exponent", 30.0, &e)) && !(e >= 0.0 && e <= 1e6))
             rc = cdl_mts_error(c, n->line, "phong exponent %g must be in [0, 1e6]", e);
         m.ns = (float)e;
+        float sc = cdl_phong_energy_scale(&m);
+        if (!rc && sc < 1.0f) {
+            cdl_mts_warn(c, n->line, "phong: diffuse + specular reflect more than all light; scaled by %.3f",
+                         (double)sc);
+            m.kd = cdl_scale(m.kd, sc);
+            m.ks = cdl_scale(m.ks, sc);
+        }
     } else if (!strcmp(type, "null")) {
         cdl_mts_warn_unused(c, n, "bsdf \"null\"");
         *mat = -1;

@@ -105,15 +105,12 @@ static int convert_material(cdl_scene *s, const char *path, const struct aiMater
             m->eta = 1.5f;
     } else if (cdl_max3(m->ks) > 0.0f) {
         m->type = CDL_MAT_PHONG;
-        /* Keep the sampling weight <= 1: Kd + Ks (n+2)/(n+1) <= 1 per channel. */
-        float lobe = (m->ns + 2.0f) / (m->ns + 1.0f);
-        float worst = fmaxf(m->kd.x + m->ks.x * lobe,
-                            fmaxf(m->kd.y + m->ks.y * lobe, m->kd.z + m->ks.z * lobe));
-        if (worst > 1.0f) {
+        float sc = cdl_phong_energy_scale(m);
+        if (sc < 1.0f) {
             cdl_warn(path, 0, "material '%s': Kd + Ks reflect more than all light; scaled by %.3f",
-                     m->name, (double)(1.0f / worst));
-            m->kd = cdl_scale(m->kd, 1.0f / worst);
-            m->ks = cdl_scale(m->ks, 1.0f / worst);
+                     m->name, (double)sc);
+            m->kd = cdl_scale(m->kd, sc);
+            m->ks = cdl_scale(m->ks, sc);
         }
     } else {
         m->type = CDL_MAT_DIFFUSE;
