@@ -196,6 +196,19 @@ CDL_API int cdl_renderer_render(cdl_renderer *r, cdl_progress_fn progress, void 
  * image between them. */
 CDL_API int cdl_renderer_render_passes(cdl_renderer *r, uint32_t n, cdl_progress_fn progress, void *user,
                                        cdl_error *err);
+/* Renders the pass with this index (0-based; a pass is deterministic given
+ * the seed and its index) and counts it as one more pass. Distributed
+ * drivers render disjoint sets of a render's passes in several processes
+ * and add their accumulators (below). */
+CDL_API int cdl_renderer_render_pass(cdl_renderer *r, uint32_t index, cdl_error *err);
+/* The render's accumulators (passes, film sums, sample counts, light-tracing
+ * splats, ray counters, AOV sums) as n = cdl_renderer_accum_size doubles:
+ * the element-wise sum of the vectors of renders (same scene and settings)
+ * of disjoint sets of passes, set into one of them, makes it the render of
+ * all those passes. _set checks the counts it is given. */
+CDL_API size_t cdl_renderer_accum_size(const cdl_renderer *r);
+CDL_API int cdl_renderer_accum_get(const cdl_renderer *r, double *out, size_t n, cdl_error *err);
+CDL_API int cdl_renderer_accum_set(cdl_renderer *r, const double *in, size_t n, cdl_error *err);
 /* Stops the render of r under way after the current pass (its tiles stop
  * early, so that pass does not count); a cancel while r is not rendering
  * has no effect. Safe from any thread and from a signal handler. */
@@ -204,6 +217,9 @@ CDL_API void cdl_renderer_cancel(cdl_renderer *r);
 CDL_API int cdl_renderer_cancelled(const cdl_renderer *r);
 
 CDL_API uint32_t cdl_renderer_passes(const cdl_renderer *r);
+/* The budget cdl_renderer_render works to: *spp > 0 passes in all, or
+ * (*spp = 0) *seconds of render time. */
+CDL_API void cdl_renderer_budget(const cdl_renderer *r, uint32_t *spp, double *seconds);
 CDL_API int cdl_renderer_width(const cdl_renderer *r);
 CDL_API int cdl_renderer_height(const cdl_renderer *r);
 CDL_API const char *cdl_renderer_integrator(const cdl_renderer *r); /* the method in use */

@@ -20,6 +20,7 @@ struct cdl_renderer {
     cdl_film film;
     int prepared, cancelled, threads;
     uint32_t passes;
+    int64_t index;  /* the pass cdl_renderer_render_pass renders, or -1: the next one */
     double seconds; /* render time so far, the method's preprocessing included */
     atomic_int cancel;
     cdl_stats stats;
@@ -69,6 +70,7 @@ int cdl_renderer_create(cdl_scene *scene, const cdl_settings *settings, cdl_rend
     const cdl_settings *in = settings ? settings : defaults;
     const cdl_log_sink *prev = cdl_log_push(&in->sink);
     r->scene = scene;
+    r->index = -1;
     atomic_init(&r->cancel, 0);
     int rc = cdl_settings_resolve(in, scene, &r->set, &r->opt, err);
     cdl_settings_release(defaults);
@@ -152,7 +154,7 @@ static int run(cdl_renderer *r, uint32_t target, double seconds, cdl_progress_fn
             r->cancelled = 1;
             break;
         }
-        rc = r->integ.vt->render_pass(r->integ.self, &r->film, r->passes, err);
+        rc = r->integ.vt->render_pass(r->integ.self, &r->film, r->index >= 0 ? (uint32_t)r->index : r->passes, err);
         if (rc)
             break; /* the passes done so far stay in the film */
         if (cdl_cancelled(&r->cancel)) {
@@ -197,6 +199,46 @@ int cdl_renderer_render_passes(cdl_renderer *r, uint32_t n, cdl_progress_fn prog
     return run(r, r->passes + n, 0.0, progress, user, err);
 }
 
+int cdl_renderer_render_pass(cdl_renderer *r, uint32_t index, cdl_error *err)
+{
+    if (!r)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_render_pass: no renderer");
+    if (r->passes == UINT32_MAX)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_render_pass: too many passes");
+    r->index = index;
+    int rc = run(r, r->passes + 1, 0.0, NULL, NULL, err);
+    r->index = -1;
+    return rc;
+}
+
+size_t cdl_renderer_accum_size(const cdl_renderer *r)
+{
+    return r ? cdl_film_accum_size(&r->film) + 1 : 0;
+}
+
+int cdl_renderer_accum_get(const cdl_renderer *r, double *out, size_t n, cdl_error *err)
+{
+    if (!r || !out || n != cdl_renderer_accum_size(r))
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_accum_get: no renderer or a wrong size");
+    out[0] = (double)r->passes;
+    cdl_film_accum_get(&r->film, out + 1);
+    return 0;
+}
+
+int cdl_renderer_accum_set(cdl_renderer *r, const double *in, size_t n, cdl_error *err)
+{
+    if (!r || !in || n != cdl_renderer_accum_size(r))
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_accum_set: no renderer or a wrong size");
+    if (!(in[0] >= 0.0 && in[0] <= (double)UINT32_MAX && in[0] == floor(in[0])))
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_accum_set: %g passes", in[0]);
+    int rc = cdl_film_accum_set(&r->film, in + 1, err);
+    if (rc)
+        return rc;
+    r->passes = (uint32_t)in[0];
+    gather_stats(r);
+    return 0;
+}
+
 void cdl_renderer_cancel(cdl_renderer *r)
 {
     if (r)
@@ -206,6 +248,12 @@ void cdl_renderer_cancel(cdl_renderer *r)
 int cdl_renderer_cancelled(const cdl_renderer *r)
 {
     return r ? r->cancelled : 0;
+}
+
+void cdl_renderer_budget(const cdl_renderer *r, uint32_t *spp, double *seconds)
+{
+    *spp = r && r->set.spp > 0 ? (uint32_t)r->set.spp : 0;
+    *seconds = r && r->set.spp <= 0 ? r->set.time : 0.0;
 }
 
 uint32_t cdl_renderer_passes(const cdl_renderer *r)

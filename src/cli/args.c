@@ -79,9 +79,11 @@ static void help(void)
 {
     printf("usage: candela render SCENE [options]\n"
            "\n"
-           "SCENE is a Wavefront OBJ file (materials from its MTL files) or a pbrt-v3/v4\n"
-           "scene file (.pbrt), whose camera, film, sampler and integrator settings apply\n"
-           "unless the options below override them.\n"
+           "SCENE is a Wavefront OBJ file (materials from its MTL files), a pbrt-v3/v4\n"
+           "scene file (.pbrt) or a Mitsuba 0.6/3 scene file (.xml), whose camera, film,\n"
+           "sampler and integrator settings apply unless the options below override them.\n"
+           "Under mpirun (a build with MPI) the passes are split over the ranks and rank 0\n"
+           "writes the image: mpirun -np N candela render SCENE --threads T ...\n"
            "\n"
            "  -o, --output FILE       .exr (32-bit float), .png (sRGB) or .pfm; repeatable\n"
            "                          (default: SCENE's name with .exr, in the current directory)\n");

@@ -27,6 +27,18 @@ int cli_report(const cdl_error *err);
 int cli_has_ext(const char *path, const char *ext);
 
 int cli_render(int argc, char **argv);
+/* The output name when none is given: the scene file's, else SCENE.exr. */
+void cli_default_output(const char *scene_path, const cdl_scene *scene, char *buf, size_t n);
+/* "candela ARGS..." for the image's metadata. */
+void cli_command_line(int argc, char **argv, char *buf, size_t n);
+
+/* mpi.c (built with MPI): under mpirun, MPI is initialized and
+ * `candela render` splits its passes over the ranks. cli_mpi_init returns
+ * the number of ranks (1 when not under mpirun). */
+int cli_mpi_init(int *argc, char ***argv);
+int cli_mpi_size(void);
+void cli_mpi_finalize(void);
+int cli_render_mpi(int argc, char **argv, const char *cmdline);
 int cli_photons(int argc, char **argv);
 int cli_diff(int argc, char **argv);
 

@@ -24,7 +24,7 @@ static void usage(FILE *f)
             "`candela render --help` lists the render options and integrators.\n");
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     if (argc < 2) {
         usage(stderr);
@@ -41,10 +41,26 @@ int main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(argv[1], "--version")) {
+#ifdef CDL_HAVE_MPI
+        printf("candela %s (MPI)\n", cdl_version());
+#else
         printf("candela %s\n", cdl_version());
+#endif
         return 0;
     }
     cdl_error err = {CDL_ERR_USAGE, 0, "", "unknown command (try candela --help)"};
     snprintf(err.file, sizeof err.file, "%s", argv[1]);
     return cli_report(&err);
+}
+
+int main(int argc, char **argv)
+{
+#ifdef CDL_HAVE_MPI
+    cli_mpi_init(&argc, &argv);
+    int status = run(argc, argv);
+    cli_mpi_finalize();
+    return status;
+#else
+    return run(argc, argv);
+#endif
 }

@@ -24,23 +24,41 @@ static int on_progress(void *user, const cdl_progress *p)
     return 0;
 }
 
-static void default_output(const char *scene, const cdl_scene_info *info, char *buf, size_t n)
+void cli_default_output(const char *scene_path, const cdl_scene *scene, char *buf, size_t n)
 {
-    if (info->output[0] &&
-        (cli_has_ext(info->output, ".exr") || cli_has_ext(info->output, ".png") || cli_has_ext(info->output, ".pfm"))) {
-        const char *b = strrchr(info->output, '/');
-        snprintf(buf, n, "%s", b ? b + 1 : info->output);
+    cdl_scene_info info;
+    cdl_scene_get_info(scene, &info);
+    if (info.output[0] &&
+        (cli_has_ext(info.output, ".exr") || cli_has_ext(info.output, ".png") || cli_has_ext(info.output, ".pfm"))) {
+        const char *b = strrchr(info.output, '/');
+        snprintf(buf, n, "%s", b ? b + 1 : info.output);
         return;
     }
-    const char *base = strrchr(scene, '/');
-    base = base ? base + 1 : scene;
+    const char *base = strrchr(scene_path, '/');
+    base = base ? base + 1 : scene_path;
     const char *dot = strrchr(base, '.');
     int len = dot ? (int)(dot - base) : (int)strlen(base);
     snprintf(buf, n, "%.*s.exr", len, base);
 }
 
+void cli_command_line(int argc, char **argv, char *buf, size_t n)
+{
+    snprintf(buf, n, "candela");
+    for (int i = 0; i < argc; i++) {
+        size_t len = strlen(buf);
+        snprintf(buf + len, n - len, " %s", argv[i]);
+    }
+}
+
 int cli_render(int argc, char **argv)
 {
+#ifdef CDL_HAVE_MPI
+    if (cli_mpi_size() > 1) {
+        char line[4096];
+        cli_command_line(argc, argv, line, sizeof line);
+        return cli_render_mpi(argc, argv, line);
+    }
+#endif
     cdl_error err;
     cli_args a;
     cdl_settings *s;
@@ -57,9 +75,7 @@ int cli_render(int argc, char **argv)
     cdl_settings_release(s);
     char defout[1024];
     if (!rc && a.nout == 0) {
-        cdl_scene_info info;
-        cdl_scene_get_info(scene, &info);
-        default_output(a.scene, &info, defout, sizeof defout);
+        cli_default_output(a.scene, scene, defout, sizeof defout);
         a.out[a.nout++] = defout;
     }
     if (rc) {
@@ -87,11 +103,8 @@ int cli_render(int argc, char **argv)
         return pass_failed;
     }
 
-    char cmdline[4096] = "candela";
-    for (int i = 0; i < argc; i++) {
-        size_t len = strlen(cmdline);
-        snprintf(cmdline + len, sizeof cmdline - len, " %s", argv[i]);
-    }
+    char cmdline[4096];
+    cli_command_line(argc, argv, cmdline, sizeof cmdline);
     rc = 0;
     for (int i = 0; !rc && i < a.nout; i++)
         rc = cdl_renderer_write(r, a.out[i], cmdline, &err);

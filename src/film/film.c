@@ -150,3 +150,69 @@ int cdl_film_resolve(const cdl_film *f, cdl_image *img, cdl_error *err)
     }
     return 0;
 }
+
+/* Layout: sum (3n), count (n), splat (3n, zeros without splats),
+ * splat_passes, rays, nonfinite, then each AOV's sums. */
+size_t cdl_film_accum_size(const cdl_film *f)
+{
+    size_t n = (size_t)f->width * (size_t)f->height, k = 7 * n + 3;
+    for (int a = 0; a < f->naovs; a++)
+        k += (size_t)f->aovs[a].channels * n;
+    return k;
+}
+
+void cdl_film_accum_get(const cdl_film *f, double *out)
+{
+    size_t n = (size_t)f->width * (size_t)f->height;
+    memcpy(out, f->sum, sizeof(double) * 3 * n);
+    out += 3 * n;
+    for (size_t i = 0; i < n; i++)
+        out[i] = (double)f->count[i];
+    out += n;
+    if (f->splat)
+        memcpy(out, f->splat, sizeof(double) * 3 * n);
+    else
+        memset(out, 0, sizeof(double) * 3 * n);
+    out += 3 * n;
+    out[0] = (double)f->splat_passes;
+    out[1] = (double)f->rays;
+    out[2] = (double)f->nonfinite;
+    out += 3;
+    for (int a = 0; a < f->naovs; a++) {
+        size_t m = (size_t)f->aovs[a].channels * n;
+        memcpy(out, f->aovs[a].sum, sizeof(double) * m);
+        out += m;
+    }
+}
+
+int cdl_film_accum_set(cdl_film *f, const double *in, cdl_error *err)
+{
+    size_t n = (size_t)f->width * (size_t)f->height;
+    const double *c = in + 3 * n, *sp = in + 4 * n, *tail = in + 7 * n;
+    for (size_t i = 0; i < n; i++)
+        if (!(c[i] >= 0.0 && c[i] <= (double)UINT32_MAX && c[i] == floor(c[i])))
+            return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "film accumulators: sample count %g is not a count", c[i]);
+    for (int k = 0; k < 3; k++)
+        if (!(tail[k] >= 0.0 && tail[k] <= 1.8e19 && tail[k] == floor(tail[k])))
+            return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "film accumulators: counter %g is not a count", tail[k]);
+    int any_splat = 0;
+    for (size_t i = 0; i < 3 * n && !any_splat; i++)
+        any_splat = sp[i] != 0.0;
+    if (any_splat && !f->splat && !(f->splat = calloc(3 * n, sizeof(double))))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");
+    memcpy(f->sum, in, sizeof(double) * 3 * n);
+    for (size_t i = 0; i < n; i++)
+        f->count[i] = (uint32_t)c[i];
+    if (f->splat)
+        memcpy(f->splat, sp, sizeof(double) * 3 * n);
+    f->splat_passes = (uint32_t)fmin(tail[0], (double)UINT32_MAX);
+    f->rays = (uint64_t)tail[1];
+    f->nonfinite = (uint64_t)tail[2];
+    in = tail + 3;
+    for (int a = 0; a < f->naovs; a++) {
+        size_t m = (size_t)f->aovs[a].channels * n;
+        memcpy(f->aovs[a].sum, in, sizeof(double) * m);
+        in += m;
+    }
+    return 0;
+}

@@ -77,4 +77,12 @@ static inline int cdl_film_add(cdl_film *f, int x, int y, cdl_vec3 L)
 /* Average per pixel into img (allocated here). */
 int cdl_film_resolve(const cdl_film *f, cdl_image *img, cdl_error *err);
 
+/* The film's accumulators (sums, sample counts, light-tracing splats,
+ * counters, AOV sums) as one vector of doubles: the vectors of renders of
+ * disjoint passes add up to the vector of all those passes (distributed
+ * rendering reduces them). _set checks the counts it is given. */
+size_t cdl_film_accum_size(const cdl_film *f);
+void cdl_film_accum_get(const cdl_film *f, double *out);
+int cdl_film_accum_set(cdl_film *f, const double *in, cdl_error *err);
+
 #endif

@@ -376,15 +376,14 @@ static uint64_t sky_light(gkde_state *s, uint32_t pass)
     return rays;
 }
 
-static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+/* A step's eye and light vertices and their points. */
+static int load_step(gkde_state *s, uint32_t pass, uint64_t *rays, cdl_error *err)
 {
-    gkde_state *s = self;
-    s->cancel = film->cancel;
     double t0 = cdl_time_now();
-    int rc = trace_eyes(s, pass, &film->rays, err);
+    int rc = trace_eyes(s, pass, rays, err);
     double t1 = cdl_time_now();
     if (!rc)
-        rc = trace_lights(s, pass, &film->rays, err);
+        rc = trace_lights(s, pass, rays, err);
     double t2 = cdl_time_now();
     s->st.t_eye += t1 - t0;
     s->st.t_light += t2 - t1;
@@ -394,14 +393,37 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
         rc = gkde_build_points(s, err);
     if (!rc)
         rc = check_memory(s, err);
+    return rc;
+}
+
+/* h and the cap come from step 0's vertices, whichever step is rendered
+ * first (a distributed render's other processes start elsewhere). */
+static void fix_bandwidth(gkde_state *s)
+{
+    float u = cap_unit(s);
+    if (!s->have_h)
+        calibrate(s, u);
+    s->r_cap = s->h * u;
+}
+
+static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
+{
+    gkde_state *s = self;
+    s->cancel = film->cancel;
+    double t0 = cdl_time_now();
+    int rc = 0;
+    if (!(s->r_cap > 0.0f) && pass != 0) {
+        uint64_t rays = 0;
+        if (!(rc = load_step(s, 0, &rays, err)) && !cdl_cancelled(s->cancel))
+            fix_bandwidth(s);
+    }
+    if (!rc)
+        rc = load_step(s, pass, &film->rays, err);
     if (rc || cdl_cancelled(s->cancel))
         return rc;
-    if (!(s->r_cap > 0.0f)) { /* the first step fixes h and the cap */
-        float u = cap_unit(s);
-        if (!s->have_h)
-            calibrate(s, u);
-        s->r_cap = s->h * u;
-    }
+    double t2 = cdl_time_now();
+    if (!(s->r_cap > 0.0f))
+        fix_bandwidth(s);
     s->g.h = s->h;
     s->g.r_cap = s->r_cap;
     rc = footprints(s, s->h, err);
