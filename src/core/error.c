@@ -7,15 +7,30 @@
 int cdl_error_set(cdl_error *err, int code, const char *file, int line,
                   const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
+    cdl_error_vset(err, code, file, line, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+int cdl_error_place(cdl_error *err, int rc, const char *from, const char *file, int line)
+{
+    if (rc && err && err->code == CDL_ERR_INPUT && err->line == 0 && !strcmp(err->file, from)) {
+        snprintf(err->file, sizeof err->file, "%s", file);
+        err->line = line;
+    }
+    return rc;
+}
+
+int cdl_error_vset(cdl_error *err, int code, const char *file, int line, const char *fmt, va_list ap)
+{
     if (!err)
         return code;
     err->code = code;
     err->line = line;
     snprintf(err->file, sizeof err->file, "%s", file ? file : "");
-    va_list ap;
-    va_start(ap, fmt);
     vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-    va_end(ap);
     /* One line per error: a newline in a message (e.g. from a library)
      * would break the contract that an error is a single line. */
     for (char *c = err->msg; *c; c++)

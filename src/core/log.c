@@ -26,13 +26,18 @@ int cdl_log_quiet(void)
 
 void cdl_warn(const char *file, int line, const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
+    cdl_vwarn(file, line, fmt, ap);
+    va_end(ap);
+}
+
+void cdl_vwarn(const char *file, int line, const char *fmt, va_list ap)
+{
     if (cdl_log_quiet())
         return;
     char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
     if (current && current->fn) {
         current->fn(current->user, file ? file : "", file && file[0] ? line : 0, msg);
         return;

@@ -5,6 +5,8 @@
 #ifndef CDL_LOG_H
 #define CDL_LOG_H
 
+#include <stdarg.h>
+
 #include <stdint.h>
 
 #include "candela/candela.h"
@@ -23,6 +25,7 @@ int cdl_log_quiet(void); /* 1 if this thread's warnings are dropped */
 
 void cdl_warn(const char *file, int line, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+void cdl_vwarn(const char *file, int line, const char *fmt, va_list ap) __attribute__((format(printf, 3, 0)));
 
 double cdl_time_now(void); /* monotonic seconds */
 

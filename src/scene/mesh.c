@@ -80,16 +80,6 @@ static int same_point(const float *a, const float *b)
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
 }
 
-/* Scene calls name the scene without a line; the shape's place is more useful. */
-static int placed(cdl_scene *s, int rc, const char *file, int line, cdl_error *err)
-{
-    if (rc && err && err->code == CDL_ERR_INPUT && err->line == 0 && !strcmp(err->file, s->path)) {
-        snprintf(err->file, sizeof err->file, "%s", file);
-        err->line = line;
-    }
-    return rc;
-}
-
 int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int reverse, uint32_t mat,
                        int32_t emit, const char *file, int line, cdl_error *err)
 {
@@ -124,7 +114,7 @@ int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int 
     }
     uint32_t first = 0;
     if (!rc)
-        rc = placed(s, cdl_scene_add_vertices(s, m->nverts, p, n, m->uv, &first, err), file, line, err);
+        rc = cdl_error_place(err, cdl_scene_add_vertices(s, m->nverts, p, n, m->uv, &first, err), s->path, file, line);
     int flip_all = reverse ^ cdl_mat4_swaps_handedness(xf);
     uint8_t flags = (uint8_t)((n ? CDL_TRI_HAS_N : 0) | (m->uv ? CDL_TRI_HAS_UV : 0));
     for (uint32_t t = 0; t < m->ntris && !rc; t++) {
@@ -154,8 +144,8 @@ int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int 
             b = d;
             d = tmp;
         }
-        rc = placed(s, cdl_scene_add_triangle(s, first + a, first + b, first + d, mat, emit, flags, err), file,
-                    line, err);
+        rc = cdl_error_place(err, cdl_scene_add_triangle(s, first + a, first + b, first + d, mat, emit, flags, err),
+                             s->path, file, line);
     }
     free(p);
     free(n);

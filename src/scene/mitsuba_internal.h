@@ -1,6 +1,7 @@
 /* State shared by the parts of the Mitsuba reader: mitsuba_loader.c (files,
  * includes, defaults, values, transforms, sensor and integrator),
- * mitsuba_shapes.c and mitsuba_materials.c (bsdfs, textures, emitters).
+ * mitsuba_values.c (property values, transforms), mitsuba_shapes.c and
+ * mitsuba_materials.c (bsdfs, textures, emitters).
  * Not a public interface.
  *
  * Mitsuba 0.6 and Mitsuba 3 name the same properties in camelCase and
@@ -71,7 +72,7 @@ void cdl_mts_warn_unused(cdl_mts_ctx *c, cdl_xml_node *n, const char *what);
  * it is not a regular file. */
 int cdl_mts_path(cdl_mts_ctx *c, int line, const char *name, char *out, size_t n);
 
-/* Typed properties (default when absent); values are validated. */
+/* mitsuba_values.c: typed properties (default when absent), validated. */
 int cdl_mts_float(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, double def, double *out);
 int cdl_mts_int(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, long def, long *out);
 int cdl_mts_bool(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, int def, int *out);
@@ -94,6 +95,10 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n);
 /* A <bsdf> element (declared at the top level or nested): its material
  * (-1: a null bsdf, no surface). */
 int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat);
+/* The first nested <bsdf> or <ref> to a bsdf among n's children (*found
+ * 0 when none); strict: a <ref> to anything else is an error (shapes),
+ * else skipped (a wrapper's texture). */
+int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat, int *found);
 /* A top-level or nested <texture>: scene texture (or -1) and value. */
 int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value);
 /* An <emitter type="area"> inside a shape: the scene emitter. */

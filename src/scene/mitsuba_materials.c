@@ -133,7 +133,7 @@ static int rel_ior(cdl_mts_ctx *c, cdl_xml_node *n, double int_def, float *eta)
     return 0;
 }
 
-static int nested_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat, int *found)
+int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat, int *found)
 {
     *found = 0;
     for (int i = 0; i < n->nkids; i++) {
@@ -149,8 +149,12 @@ static int nested_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat, int *found
             if (rc)
                 return rc;
             const cdl_mts_id *d = id ? cdl_mts_find_id(c, id) : NULL;
+            if (strict && !d)
+                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> is not declared before", id ? id : "");
+            if (strict && d->kind != CDL_MTS_BSDF)
+                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> in a shape must name a bsdf", id);
             if (!d || d->kind != CDL_MTS_BSDF)
-                continue; /* a texture reference of the wrapper */
+                continue; /* a texture reference of a wrapper */
             k->used = 1;
             *found = 1;
             *mat = d->mat;
@@ -216,7 +220,7 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
                                        "roughcoating"};
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
         if (!strcmp(type, wrap[i])) {
-            if ((rc = nested_bsdf(c, n, mat, &found)))
+            if ((rc = cdl_mts_child_bsdf(c, n, 0, mat, &found)))
                 return rc;
             if (!found)
                 return cdl_mts_error(c, n->line, "bsdf \"%s\" needs a nested <bsdf> or <ref>", type);

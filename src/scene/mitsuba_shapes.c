@@ -126,39 +126,16 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
 }
 
 /* The shape's surface: a nested <bsdf>, a <ref> to one, or Mitsuba's default. */
-static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat, int *given)
+static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
-    *given = 0;
-    for (int i = 0; i < n->nkids; i++) {
-        cdl_xml_node *k = &n->kids[i];
-        if (!strcmp(k->name, "bsdf")) {
-            k->used = 1;
-            *given = 1;
-            return cdl_mts_bsdf(c, k, mat);
-        }
-        if (!strcmp(k->name, "ref")) {
-            int rc = 0;
-            const char *id = cdl_mts_attr(c, k, "id", &rc);
-            if (rc)
-                return rc;
-            const cdl_mts_id *d = id ? cdl_mts_find_id(c, id) : NULL;
-            if (!d)
-                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> is not declared before", id ? id : "");
-            if (d->kind != CDL_MTS_BSDF)
-                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> in a shape must name a bsdf", id);
-            k->used = 1;
-            *given = 1;
-            *mat = d->mat;
-            return 0;
-        }
-    }
-    return cdl_mts_default_material(c, mat);
+    int found, rc = cdl_mts_child_bsdf(c, n, 1, mat, &found);
+    return rc || found ? rc : cdl_mts_default_material(c, mat);
 }
 
 int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
 {
     char type[64];
-    int rc = cdl_mts_type(c, n, type, sizeof type), flip, given;
+    int rc = cdl_mts_type(c, n, type, sizeof type), flip;
     if (rc)
         return rc;
     n->used = 1;
@@ -175,7 +152,7 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
     cdl_mat4 m;
     int32_t mat, emit = -1;
     if ((rc = cdl_mts_transform(c, n, "to_world", &m)) || (rc = cdl_mts_bool(c, n, "flip_normals", 0, &flip)) ||
-        (rc = shape_bsdf(c, n, &mat, &given)))
+        (rc = shape_bsdf(c, n, &mat)))
         return rc;
     for (int i = 0; i < n->nkids && !rc; i++)
         if (!strcmp(n->kids[i].name, "emitter")) {

@@ -19,34 +19,24 @@
 
 int cdl_pbrt_error(cdl_pbrt_ctx *c, int line, const char *fmt, ...)
 {
-    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    cdl_error_vset(c->err, CDL_ERR_INPUT, c->file, line, fmt, ap);
     va_end(ap);
-    return cdl_error_set(c->err, CDL_ERR_INPUT, c->file, line, "%s", msg);
+    return CDL_ERR_INPUT;
 }
 
 void cdl_pbrt_warn(cdl_pbrt_ctx *c, int line, const char *fmt, ...)
 {
-    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    cdl_vwarn(c->file, line, fmt, ap);
     va_end(ap);
-    cdl_warn(c->file, line, "%s", msg);
 }
 
 int cdl_pbrt_scene_rc(cdl_pbrt_ctx *c, int rc)
 {
-    /* scene calls name the scene without a line; the directive is more
-     * useful (texture decoding errors keep naming the image, as for OBJ) */
-    if (rc && c->err && c->err->code == CDL_ERR_INPUT && c->err->line == 0 &&
-        !strcmp(c->err->file, c->s->path)) {
-        snprintf(c->err->file, sizeof c->err->file, "%s", c->file);
-        c->err->line = c->line;
-    }
-    return rc;
+    return cdl_error_place(c->err, rc, c->s->path, c->file, c->line);
 }
 
 void cdl_pbrt_resolve(const cdl_pbrt_ctx *c, const char *name, char *out, size_t n)

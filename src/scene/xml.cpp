@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
-#include <vector>
 
 extern "C" {
 #include "core/file.h"
@@ -19,7 +18,8 @@ namespace {
 const int max_depth = 64;
 
 struct copier {
-    std::vector<size_t> line_starts; // offset of each line's first byte
+    size_t *line_starts = nullptr; // offset of each line's first byte (malloc'd: no
+    size_t nlines = 0;             // exported std:: template instances in the library)
     const char *path;
     cdl_error *err;
     int rc = 0;
@@ -28,7 +28,7 @@ struct copier {
     {
         if (off < 0)
             return 0;
-        size_t lo = 0, hi = line_starts.size();
+        size_t lo = 0, hi = nlines;
         while (hi - lo > 1) {
             size_t mid = (lo + hi) / 2;
             if (line_starts[mid] <= (size_t)off)
@@ -111,14 +111,21 @@ extern "C" int cdl_xml_load(const char *path, cdl_xml_doc *doc, cdl_error *err)
     int rc = cdl_read_file(path, (uint64_t)256 << 20, &data, &size, err);
     if (rc)
         return rc;
+    copier c;
     try {
-        copier c;
         c.path = path;
         c.err = err;
-        c.line_starts.push_back(0);
+        size_t nl = 1;
+        for (size_t i = 0; i < size; i++)
+            nl += data[i] == '\n';
+        if (!(c.line_starts = (size_t *)malloc(nl * sizeof(size_t)))) {
+            free(data);
+            return cdl_error_set(err, CDL_ERR_SYSTEM, path, 0, "out of memory");
+        }
+        c.line_starts[c.nlines++] = 0;
         for (size_t i = 0; i < size; i++)
             if (data[i] == '\n')
-                c.line_starts.push_back(i + 1);
+                c.line_starts[c.nlines++] = i + 1;
         pugi::xml_document xd;
         // parse_default keeps offsets valid for offset_debug(); no DOCTYPE entities are expanded.
         pugi::xml_parse_result res = xd.load_buffer(data, size, pugi::parse_default, pugi::encoding_auto);
@@ -134,6 +141,7 @@ extern "C" int cdl_xml_load(const char *path, cdl_xml_doc *doc, cdl_error *err)
     } catch (const std::bad_alloc &) {
         rc = cdl_error_set(err, CDL_ERR_SYSTEM, path, 0, "out of memory");
     }
+    free(c.line_starts);
     free(data);
     if (rc)
         cdl_xml_free(doc);
