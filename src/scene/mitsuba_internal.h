@@ -1,5 +1,5 @@
 /* State shared by the parts of the Mitsuba reader: mitsuba_loader.c (files,
- * includes, defaults, values, transforms, sensor and integrator),
+ * includes, defaults, ids, sensor and integrator),
  * mitsuba_values.c (property values, transforms), mitsuba_shapes.c and
  * mitsuba_materials.c (bsdfs, textures, emitters).
  * Not a public interface.
