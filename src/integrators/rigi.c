@@ -125,18 +125,6 @@ typedef struct tile_work {
     uint32_t cap_bundle;
 } tile_work;
 
-/* Direct light from every light at infinity at an eye vertex: one light
- * sample each (the maps importance-sampled), one shadow ray. */
-static cdl_vec3 light_at_infinity(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
-                                  cdl_sampler *smp, uint64_t *rays)
-{
-    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
-    for (uint32_t i = 0; i < s->nlights; i++)
-        if (cdl_light_at_infinity(&s->lights[i]))
-            L = cdl_add(L, cdl_sample_light(s, i, sf, b, wo, smp, rays));
-    return L;
-}
-
 static int grow_cand(tile_work *w)
 {
     uint32_t cap = w->cap_cand ? 2 * w->cap_cand : 4096;
@@ -213,7 +201,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
                 return L;
             w->eye_pixel[i] = pixel;
             if (st->at_infinity && depth < st->opt.maxdepth) {
-                cdl_vec3 e = cdl_mul(beta, light_at_infinity(s, &sf, &b, wo, smp, rays));
+                cdl_vec3 e = cdl_mul(beta, cdl_direct_light_infinite(s, &sf, &b, wo, smp, rays));
                 L = cdl_add(L, e);
                 w->strata[pixel][stratum] = cdl_add(w->strata[pixel][stratum], e);
             }

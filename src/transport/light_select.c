@@ -81,6 +81,16 @@ cdl_vec3 cdl_sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf
     return cdl_scale(cdl_mul(f, ls.Li), cos / ls.pdf);
 }
 
+cdl_vec3 cdl_direct_light_infinite(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
+                                   cdl_sampler *smp, uint64_t *rays)
+{
+    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
+    for (uint32_t i = 0; i < s->nlights; i++)
+        if (cdl_light_at_infinity(&s->lights[i]))
+            L = cdl_add(L, cdl_sample_light(s, i, sf, b, wo, smp, rays));
+    return L;
+}
+
 cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lcon_scratch *sc,
                           const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo, cdl_sampler *smp,
                           uint64_t *rays, uint32_t *nlcon)

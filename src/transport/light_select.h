@@ -43,6 +43,13 @@ typedef struct cdl_direct_cfg {
 cdl_vec3 cdl_sample_light(const cdl_scene *s, uint32_t li, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
                           cdl_sampler *smp, uint64_t *rays);
 
+/* Direct light from every light at infinity (distant, infinite): one
+ * sample each (maps importance-sampled), one shadow ray each. Methods whose
+ * light paths start on the disk covering the scene take that light this
+ * way: the disk point is no point in the scene to connect or splat from. */
+cdl_vec3 cdl_direct_light_infinite(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo,
+                                   cdl_sampler *smp, uint64_t *rays);
+
 /* Reflected direct light at a surface point towards wo. *nlcon gets |L_con|. */
 cdl_vec3 cdl_direct_light(const cdl_scene *s, const cdl_direct_cfg *cfg, cdl_lcon_scratch *sc,
                           const cdl_surface *sf, const cdl_bsdf *b, cdl_vec3 wo, cdl_sampler *smp,

@@ -14,6 +14,7 @@ int cdl_find_visible(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, int maxdepth, c
         cdl_hit h;
         (*rays)++;
         if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
+            v->depth = depth; /* the sky met after `depth` specular bounces */
             if (s->env_light >= 0)
                 v->L = cdl_add(v->L, cdl_mul(v->beta, cdl_light_env_Le(&s->lights[s->env_light], d)));
             return 0;

@@ -16,7 +16,7 @@ typedef struct cdl_visible {
     cdl_surface sf;
     cdl_bsdf b;
     cdl_vec3 wo;   /* unit direction back along the ray */
-    int depth;     /* specular bounces before the point */
+    int depth;     /* specular bounces before the point (or before the ray left the scene) */
     float dist;    /* length of the chain from the ray's origin to the point */
 } cdl_visible;
 
