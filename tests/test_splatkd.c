@@ -90,6 +90,7 @@ static void traversal(void)
         ray.h0 = 0.1f * cdl_rng_float(&r);
         ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
         ray.cap = k % 3 == 1 ? 0.0f : 4.0f;
+        ray.zmin = k % 3 ? 0.0f : 1e-3f;
         a.n = b.n = c.n = e.n = 0;
         cdl_skd_splat_brute(&t, UINT32_MAX, &ray, &a);
         uint64_t t0 = b.tested;
@@ -195,7 +196,7 @@ static void irradiance(float theta, float cap)
             for (int j = -150; j <= 150; j++) {
                 float a = ((float)i + cdl_rng_float(&r) - 0.5f) * g, b = ((float)j + cdl_rng_float(&r) - 0.5f) * g;
                 cdl_vec3 hit = cdl_v3(0.5f + a / cosf(theta), 0.0f, 0.5f + b);
-                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f, cap};
+                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f, cap, 0.0f};
                 if (backside) { /* from below: the samples show their top */
                     ray.d = cdl_neg(d);
                     ray.o = cdl_add(hit, cdl_scale(d, 2.0f));
@@ -224,8 +225,26 @@ static void irradiance(float theta, float cap)
     cdl_skd_free(&t);
 }
 
+/* A ray leaving the back of a thin two-sided sheet feeds no sample on its
+ * front (they face the ray and lie on the origin's tangent plane), but a
+ * sample of a wall meeting the sheet in a concave corner is fed however
+ * close to the sheet it lies. */
+static void sheet(void)
+{
+    cdl_vec3 d = cdl_normalize(cdl_v3(0.3f, 0.0f, -1.0f));
+    cdl_splat_ray ray = {cdl_v3(0, 0, 0), d, cdl_v3(0, 0, -1), 1.0f, 0.2f, 0.0f, 4.0f, 1e-5f};
+    float z, front = cdl_splat_weight(&ray, cdl_v3(0.05f, 0.0f, 0.0f), cdl_v3(0, 0, 1), 0, &z);
+    float wall = cdl_splat_weight(&ray, cdl_v3(0.05f, 0.0f, -1e-6f), cdl_v3(-1, 0, 0), 0, &z);
+    ray.zmin = 0.0f;
+    float leak = cdl_splat_weight(&ray, cdl_v3(0.05f, 0.0f, 0.0f), cdl_v3(0, 0, 1), 0, &z);
+    CHECK(front == 0.0f && wall > 0.0f && leak > 0.0f,
+          "sheet: the front of the sheet a ray leaves gets %g (%g with zmin 0), a corner's wall %g", (double)front,
+          (double)leak, (double)wall);
+}
+
 int main(void)
 {
+    sheet();
     traversal();
     irradiance(0.0f, 0.0f);
     irradiance(0.6f, 0.0f);

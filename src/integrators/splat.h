@@ -112,7 +112,12 @@ int splat_cache_aov(const splat_state *s, uint32_t q, float out[3]);
 /* A photon ray as the eye-sample tree's frustum queries take it. */
 static inline cdl_splat_ray splat_ray_of(const splat_state *s, const cdl_photon_ray *r)
 {
-    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap};
+    /* samples on the origin's own surface (the other side of a two-sided
+     * sheet the ray left: they face it) lie within a hit point's offset
+     * (cdl_offset) of its tangent plane; a point light has no surface */
+    float m = cdl_maxf(fabsf(r->o.x), cdl_maxf(fabsf(r->o.y), fabsf(r->o.z)));
+    float zmin = cdl_is_black(r->on) ? 0.0f : s->scene->eps + m * 1e-5f;
+    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap, zmin};
 }
 /* The visibility mask (§8.1, splat_mask.c): the rays' occlusion buffers
  * built a batch at a time; filter drops from a batch's mask the samples

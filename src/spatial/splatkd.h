@@ -84,10 +84,18 @@ size_t cdl_skd_bytes(const cdl_skd *t);
  *        kernel beyond the corner), out to c h(len) beyond x_i, with the
  *        plain kernel: the irradiance on a plane is exact up to incidence
  *        atan(c), and the estimate consistent. */
+/* A sample whose normal is within about 25 degrees of the opposite of the
+ * ray origin's and which lies within zmin of its tangent plane is on the
+ * other side of the origin's surface (see zmin). */
+#define CDL_SKD_SHEET_COS -0.9f
+
 typedef struct cdl_splat_ray {
     cdl_vec3 o, d, on;
     float len, h0, dh;
     float cap;
+    float zmin; /* least height over the origin's tangent plane of a sample
+                 * facing back into it (its other side, if the origin's
+                 * surface is a thin two-sided sheet): a little above 0 */
 } cdl_splat_ray;
 
 /* A feasible eye sample: its tree position, kernel times cosine (per unit
@@ -122,7 +130,8 @@ static inline float cdl_splat_weight_grad(const cdl_splat_ray *r, cdl_vec3 p, cd
         return 0.0f;
     cdl_vec3 D = cdl_sub(p, r->o);
     float z = cdl_dot(D, r->d);
-    if (!(z >= 0.0f) || cdl_dot(D, r->on) < 0.0f)
+    float zn = cdl_dot(D, r->on);
+    if (!(z >= 0.0f) || zn < 0.0f || (zn < r->zmin && cdl_dot(n, r->on) < CDL_SKD_SHEET_COS))
         return 0.0f;
     float h = r->h0 + r->dh * (z < r->len ? z : r->len);
     float h2 = h * h;

@@ -67,6 +67,11 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
+    /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
+    __m512 non = _mm512_fmadd_ps(nz, _mm512_set1_ps(r->on.z),
+                                 _mm512_fmadd_ps(ny, _mm512_set1_ps(r->on.y), _mm512_mul_ps(nx, _mm512_set1_ps(r->on.x))));
+    ok &= (__mmask16)(_mm512_cmp_ps_mask(zn, _mm512_set1_ps(r->zmin), _CMP_GE_OQ) |
+                      _mm512_cmp_ps_mask(non, _mm512_set1_ps(CDL_SKD_SHEET_COS), _CMP_GE_OQ));
     if (plane) {
         /* reached the sample's tangent plane ((D . n) / dn <= X, without
          * the division), or ended within h of the sample (a neighbouring
@@ -105,6 +110,7 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
+    const float zmin = r->zmin;
     const float norm = (float)(2.0 / CDL_PI);
     const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
     const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
@@ -122,7 +128,9 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         float r2 = ex * ex + ey * ey + ez * ez;
         float h = h0 + dh * (z < len ? z : len);
         float h2 = h * h, beyond = z - len;
-        int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f);
+        float non = nx[i] * nx0 + ny[i] * ny0 + nz[i] * nz0;
+        /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
+        int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f) & ((zn >= zmin) | (non >= CDL_SKD_SHEET_COS));
         if (plane) {
             /* the distance tp = (D . n) / dn to the sample's tangent plane
              * against X, without the division: dn < 0 flips the test */
