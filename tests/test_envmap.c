@@ -41,6 +41,10 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
         opt->light_paths = 2000;
         spp /= 4;
     }
+    if (!strcmp(integ, "splat")) { /* a pass traces and splats its photon rays */
+        opt->splat.photons = 5000;
+        spp /= 4;
+    }
     if (!strcmp(integ, "bdpt-shared")) { /* shared light paths in 2 x 2 sets */
         opt->light_paths = 64;
         opt->interleave = 2;

@@ -5,7 +5,10 @@
  *     specular surfaces (transport/visible.c) to an eye sample: position,
  *     the normal of the side seen, BSDF, direction to the camera, pixel,
  *     weight; emission met on the way (and, with --direct sample, light
- *     sampled at the sample) goes straight to the pixel;
+ *     sampled at the sample) goes straight to the pixel; so does the
+ *     direct light of lights at infinity, always by light sampling (their
+ *     photon paths start on a disk outside the scene, and that first ray
+ *     is not splatted);
  *  2. the eye-sample kd-tree (spatial/splatkd.c, §5.1);
  *  3. light pass: photon rays with path-density bandwidths
  *     (transport/photon_rays.c, §4.2), the bandwidth's M growing with the
@@ -60,6 +63,17 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     int specular = 0;
     for (uint32_t m = 0; m < scene->nmats; m++)
         specular |= cdl_mat_is_delta(scene->mats[m].type);
+    /* lights at infinity emit no direct photons (their first ray starts on
+     * the disk outside the scene): with no other light the direct share
+     * stays unused, as with --direct sample */
+    int finite = 0;
+    for (uint32_t i = 0; i < scene->nlights; i++) {
+        if (cdl_light_at_infinity(&scene->lights[i]))
+            s->at_infinity = 1;
+        else if (scene->light_select.pmf[i] > 0.0f)
+            finite = 1;
+    }
+    s->no_photons = !finite && opt->maxdepth <= 1;
     float share[CDL_PRAY_CATS] = {fd, o->fractions[1], o->fractions[2]};
     if (!specular) {
         share[CDL_PRAY_INDIRECT] += share[CDL_PRAY_CAUSTIC];
@@ -69,13 +83,14 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
         float f = share[c] / fsum;
         /* with light sampling the direct share stays unused (gather
          * rays' hits need direct photons all the same) */
-        if (c == CDL_PRAY_DIRECT && o->direct_sample && !o->gather)
+        if (c == CDL_PRAY_DIRECT && ((o->direct_sample && !o->gather) || !finite))
             f = 0.0f;
-        s->pp.target[c] = (uint32_t)lrint((double)f * o->photons);
+        s->pp.target[c] = s->no_photons ? 0 : (uint32_t)lrint((double)f * o->photons);
     }
-    if (!s->pp.target[0] && !s->pp.target[1] && !s->pp.target[2])
+    if (!s->pp.target[0] && !s->pp.target[1] && !s->pp.target[2] && !s->no_photons)
         return cdl_error_set(err, CDL_ERR_USAGE, "--fractions", 0,
-                             "no photon budget left (with --direct sample the direct share is unused)");
+                             "no photon budget left (with --direct sample, or only lights at infinity, the direct "
+                             "share is unused)");
     s->pp.C = o->C;
     s->pp.S = o->S;
     s->pp.R = o->R;
@@ -171,8 +186,13 @@ static cdl_vec3 gather(splat_state *s, const cdl_visible *v, cdl_vec3 w, uint32_
                                    rays, &vg);
         if (vg.depth > 0)
             L = cdl_add(L, cdl_mul(wg, vg.L));
-        if (hit)
-            fill_slot(s, k0 + g, &vg, cdl_mul(wg, vg.beta), p, vg.dist * spread);
+        if (!hit)
+            continue;
+        cdl_vec3 wh = cdl_mul(wg, vg.beta);
+        fill_slot(s, k0 + g, &vg, wh, p, vg.dist * spread);
+        /* no photon brings the lights at infinity's direct light there */
+        if (s->at_infinity && v->depth + vg.depth + 2 <= s->opt.maxdepth)
+            L = cdl_add(L, cdl_mul(wh, cdl_direct_light_infinite(sc, &vg.sf, &vg.b, vg.wo, smp, rays)));
     }
     return L;
 }
@@ -207,6 +227,10 @@ static void eye_row(splat_state *s, int y, int y0, uint32_t pass, const cdl_dire
             if (direct) {
                 uint32_t nl = 0;
                 cdl_vec3 Ld = cdl_direct_light(sc, dc, lc, &v.sf, &v.b, v.wo, &smp, rays, &nl);
+                base = cdl_add(base, cdl_mul(v.beta, Ld));
+            } else if (s->at_infinity && !s->opt.splat.direct_none) {
+                /* direct photons come from the other lights only */
+                cdl_vec3 Ld = cdl_direct_light_infinite(sc, &v.sf, &v.b, v.wo, &smp, rays);
                 base = cdl_add(base, cdl_mul(v.beta, Ld));
             }
             cdl_vec3 w = cdl_scale(v.beta, 1.0f / (float)E);
@@ -334,6 +358,10 @@ static int photon_rays(splat_state *s, cdl_film *film, uint32_t pass, cdl_error 
 {
     double t0 = cdl_time_now();
     int rc;
+    if (s->no_photons) { /* light sampling gives all there is */
+        s->rays.n = 0;
+        return 0;
+    }
     if (!s->have_pilot) {
         rc = cdl_pray_pilot(s->scene, &s->walk, s->opt.sampler, s->opt.seed, PILOT_PATHS, s->pp.S, s->pp.d2_clamp,
                             &s->pp.w, &s->pp.mu, err);

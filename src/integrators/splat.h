@@ -40,6 +40,8 @@ typedef struct splat_state {
     cdl_walk walk;
     cdl_pray_params pp;
     int have_pilot;
+    int at_infinity; /* the scene has distant or infinite lights: their direct light by light sampling */
+    int no_photons;  /* only lights at infinity and --maxdepth 1: no photon rays at all */
     cdl_pray_set rays; /* in Morton order of their ends */
     /* eye samples: slots per pixel sample while tracing, then tree order */
     cdl_vec3 *sp, *sn;

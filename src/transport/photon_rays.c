@@ -1,5 +1,6 @@
 #include "transport/photon_rays.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,11 +33,33 @@ static double next_density(const cdl_vertex_store *vs, const double *pt, uint32_
     return isfinite(p) ? p : 0.0;
 }
 
+/* p~(x_1) of a path from light l at infinity: its direction's density
+ * (a distant light's one direction counts as 1, as a point light's one
+ * position does) times the disk's 1 / (pi R^2). Rays from the disk are
+ * parallel, so the density per area perpendicular to them at x_1 is the
+ * disk's and no 1 / D falls off with distance. */
+static double disk_density(const cdl_scene *s, const cdl_vertex_store *vs)
+{
+    const cdl_light *l = &s->lights[vs->light[0]];
+    cdl_vec3 w = cdl_normalize(cdl_sub(vs->p[0], vs->p[1])); /* towards the light */
+    double p = s->light_select.pmf[vs->light[0]] * cdl_light_pdf_disk(l, w, cdl_v3(0.0f, 0.0f, 0.0f));
+    if (!cdl_light_is_delta(l))
+        p *= cdl_light_pdf_li(l, cdl_v3(0.0f, 0.0f, 0.0f), w, FLT_MAX);
+    return isfinite(p) ? p : 0.0;
+}
+
 /* p~ of every vertex of a traced path; 0 where it is undefined. */
-static void path_density(const cdl_vertex_store *vs, uint32_t nv, float d2c, double *pt)
+static void path_density(const cdl_scene *s, const cdl_vertex_store *vs, uint32_t nv, float d2c, double *pt)
 {
     pt[0] = 0.0;
-    for (uint32_t i = 1; i < nv; i++) {
+    uint32_t first = 1;
+    if (nv > 1 && (vs->flags[0] & CDL_V_INFINITE)) {
+        /* y_0 on the disk: pdf_fwd[1] is the disk's density, not one that
+         * turns back into a direction's at y_0 */
+        pt[1] = disk_density(s, vs);
+        first = 2;
+    }
+    for (uint32_t i = first; i < nv; i++) {
         cdl_vec3 d = cdl_sub(vs->p[i], vs->p[i - 1]);
         double d2 = cdl_dot(d, d), len = sqrt(d2);
         pt[i] = 0.0;
@@ -171,8 +194,9 @@ static void trace_path(const trace_ctx *cx, uint64_t i, uint32_t off, cdl_vertex
     uint32_t nv = cdl_trace_light_subpath_esc(cx->s, cx->walk, &smp, vs, &b->rays, &esc);
     if (nv < 1)
         return;
-    path_density(vs, nv, cx->d2c, pt);
+    path_density(cx->s, vs, nv, cx->d2c, pt);
     int all_specular = 1; /* every bounce before the current ray's end */
+    int disk = (vs->flags[0] & CDL_V_INFINITE) != 0;
     double h_prev = 0.0;
     for (uint32_t v = 1; v < nv; v++) {
         cdl_vec3 d = cdl_sub(vs->p[v], vs->p[v - 1]);
@@ -180,14 +204,24 @@ static void trace_path(const trace_ctx *cx, uint64_t i, uint32_t off, cdl_vertex
         int cat = category(v, all_specular);
         if (!(vs->flags[v] & CDL_V_DELTA))
             all_specular = 0; /* for the next ray: x_v scattered it */
+        if (v == 1 && disk) {
+            /* the ray from the disk of a light at infinity brings direct
+             * light, which the eye samples take by light sampling (its
+             * origin is no scene point to splat from); x_1's bandwidth
+             * starts the next ray's kernel */
+            if (cx->pp) /* no flux: sets h_prev only */
+                add_ray(cx, vs, v, d, len, cdl_v3(0.0f, 0.0f, 0.0f), pt[1], category(2, all_specular), &h_prev, off,
+                        b);
+            continue;
+        }
         if (!(len > 0.0f) || vs->depth[v] > cx->walk->maxdepth)
             continue;
         add_ray(cx, vs, v, cdl_scale(d, 1.0f / len), len, vs->beta[v], pt[v], cat, &h_prev, off, b);
     }
     /* the ray that left the scene passes eye samples too: it runs to the
-     * scene's bounds */
+     * scene's bounds (not one from the disk that missed the scene) */
     uint32_t last = nv - 1;
-    if (!esc.escaped || (int)vs->depth[last] + 1 > cx->walk->maxdepth)
+    if (!esc.escaped || (last == 0 && disk) || (int)vs->depth[last] + 1 > cx->walk->maxdepth)
         return;
     const cdl_scene *s = cx->s;
     float len = exit_distance(vs->p[last], esc.d, s->bmin, s->bmax, 1e-6f);
@@ -243,11 +277,9 @@ static int check_lights(const cdl_scene *s, cdl_error *err)
     if (!s->nlights)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "the scene has no lights: no photons to trace");
     for (uint32_t i = 0; i < s->nlights; i++)
-        if (!cdl_light_at_infinity(&s->lights[i]) &&
-            s->light_select.pmf[i] > 0.0f)
+        if (s->light_select.pmf[i] > 0.0f)
             return 0;
-    return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
-                         "photons start only on area, sphere, point and spot lights; this scene has none");
+    return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "the scene's lights emit nothing: no photons to trace");
 }
 
 int cdl_pray_pilot(const cdl_scene *s, const cdl_walk *walk, cdl_sampler_kind kind, uint64_t seed,

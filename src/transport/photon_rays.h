@@ -16,6 +16,11 @@
  * |x_i - x_{i-1}|. Lengths are in scene units throughout: mu_C and D~ come
  * from the scene, so the report's metre convention needs no conversion.
  *
+ * Paths from lights at infinity start on the disk covering the scene
+ * (the shared tracer): their first ray is not stored (its direct light
+ * comes by light sampling; the disk point is no scene point), and
+ * p~(x_1) is the direction's density times the disk's 1 / (pi R^2).
+ *
  * Rays fall into three budgets: direct (i = 1), caustic (every bounce
  * before x_i specular) and indirect (the rest). Paths are traced in index
  * order until each budget is full; a budget's rays carry power / N_c, N_c
