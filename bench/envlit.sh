@@ -32,4 +32,5 @@ pm|
 rigi|
 ir|
 gkde|
+splat|
 EOT
