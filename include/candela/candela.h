@@ -209,6 +209,18 @@ CDL_API int cdl_renderer_render_pass(cdl_renderer *r, uint32_t index, cdl_error 
 CDL_API size_t cdl_renderer_accum_size(const cdl_renderer *r);
 CDL_API int cdl_renderer_accum_get(const cdl_renderer *r, double *out, size_t n, cdl_error *err);
 CDL_API int cdl_renderer_accum_set(cdl_renderer *r, const double *in, size_t n, cdl_error *err);
+/* Methods whose passes adapt to earlier ones (gkde's visibility tallies)
+ * fold what they learnt at pass indices 1, 2, 4, 8, ...: pass i uses what
+ * the passes before the last fold at or below i learnt. A distributed
+ * driver keeps every process equal to one process: before any process
+ * renders a pass >= cdl_renderer_adapt_next (and, after its last pass,
+ * for each fold below the job's passes), all sum their adapt_get vectors
+ * and each calls adapt_fold with the sum. *n = 0: the method does not
+ * adapt (then next is UINT32_MAX). adapt_size prepares the method. */
+CDL_API int cdl_renderer_adapt_size(cdl_renderer *r, size_t *n, cdl_error *err);
+CDL_API uint32_t cdl_renderer_adapt_next(const cdl_renderer *r);
+CDL_API int cdl_renderer_adapt_get(const cdl_renderer *r, double *out, size_t n, cdl_error *err);
+CDL_API int cdl_renderer_adapt_fold(cdl_renderer *r, const double *sum, size_t n, cdl_error *err);
 /* Stops the render of r under way after the current pass (its tiles stop
  * early, so that pass does not count); a cancel while r is not rendering
  * has no effect. Safe from any thread and from a signal handler. */

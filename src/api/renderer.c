@@ -126,6 +126,15 @@ static void gather_stats(cdl_renderer *r)
         r->integ.vt->report(r->integ.self, s);
 }
 
+static int prepare(cdl_renderer *r, cdl_error *err)
+{
+    if (r->prepared)
+        return 0;
+    int rc = r->integ.vt->prepare(r->integ.self, r->scene, &r->opt, err);
+    r->prepared = !rc;
+    return rc;
+}
+
 /* Passes until target passes in all (target > 0) or until the render time
  * would exceed seconds, or a cancel. */
 static int run(cdl_renderer *r, uint32_t target, double seconds, cdl_progress_fn fn, void *user, cdl_error *err)
@@ -138,11 +147,7 @@ static int run(cdl_renderer *r, uint32_t target, double seconds, cdl_progress_fn
     atomic_store(&r->cancel, 0);
     r->cancelled = 0;
     double t0 = cdl_time_now() - r->seconds;
-    int rc = 0;
-    if (!r->prepared) {
-        rc = r->integ.vt->prepare(r->integ.self, r->scene, &r->opt, err);
-        r->prepared = !rc;
-    }
+    int rc = prepare(r, err);
     uint32_t start = r->passes;
     double t_loop = cdl_time_now();
     while (!rc) {
@@ -236,6 +241,49 @@ int cdl_renderer_accum_set(cdl_renderer *r, const double *in, size_t n, cdl_erro
         return rc;
     r->passes = (uint32_t)in[0];
     gather_stats(r);
+    return 0;
+}
+
+int cdl_renderer_adapt_size(cdl_renderer *r, size_t *n, cdl_error *err)
+{
+    *n = 0;
+    if (!r)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_adapt_size: no renderer");
+    if (!r->integ.vt->adapt_size)
+        return 0;
+    const cdl_log_sink *prev = cdl_log_push(&r->set.sink);
+    int threads = omp_get_max_threads();
+    if (r->set.threads > 0)
+        omp_set_num_threads((int)r->set.threads);
+    int rc = prepare(r, err); /* the state is the method's: it must exist */
+    omp_set_num_threads(threads);
+    cdl_log_pop(prev);
+    if (!rc)
+        *n = r->integ.vt->adapt_size(r->integ.self);
+    return rc;
+}
+
+uint32_t cdl_renderer_adapt_next(const cdl_renderer *r)
+{
+    return r && r->prepared && r->integ.vt->adapt_next ? r->integ.vt->adapt_next(r->integ.self) : UINT32_MAX;
+}
+
+int cdl_renderer_adapt_get(const cdl_renderer *r, double *out, size_t n, cdl_error *err)
+{
+    if (!r || !r->prepared || !r->integ.vt->adapt_get || !out || n != r->integ.vt->adapt_size(r->integ.self))
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_adapt_get: no adaptive state of that size");
+    r->integ.vt->adapt_get(r->integ.self, out);
+    return 0;
+}
+
+int cdl_renderer_adapt_fold(cdl_renderer *r, const double *sum, size_t n, cdl_error *err)
+{
+    if (!r || !r->prepared || !r->integ.vt->adapt_fold || !sum || n != r->integ.vt->adapt_size(r->integ.self))
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_adapt_fold: no adaptive state of that size");
+    for (size_t i = 0; i < n; i++)
+        if (!(sum[i] >= 0.0 && sum[i] < 1.8e19))
+            return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_adapt_fold: %g is not a tally", sum[i]);
+    r->integ.vt->adapt_fold(r->integ.self, sum);
     return 0;
 }
 

@@ -82,6 +82,31 @@ static int agree(int rc, const cdl_error *err)
     return status;
 }
 
+/* MPI counts are ints: sums in chunks (root < 0: every rank gets them). */
+static void sum_doubles(const double *in, double *out, size_t n, int root)
+{
+    const size_t chunk = (size_t)1 << 26;
+    for (size_t off = 0; off < n; off += chunk) {
+        int m = (int)(n - off < chunk ? n - off : chunk);
+        if (root < 0)
+            MPI_Allreduce(in + off, out + off, m, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+        else
+            MPI_Reduce(in + off, out ? out + off : NULL, m, MPI_DOUBLE, MPI_SUM, root, MPI_COMM_WORLD);
+    }
+}
+
+/* The folds of an adapting method (gkde) up to pass upto, each with the
+ * state summed over the ranks: every rank runs the same sequence. */
+static void fold_adaptive(cdl_renderer *r, double *mine, double *sum, size_t n, uint32_t upto)
+{
+    cdl_error err;
+    while (n && cdl_renderer_adapt_next(r) <= upto) {
+        cdl_renderer_adapt_get(r, mine, n, &err);
+        sum_doubles(mine, sum, n, -1);
+        cdl_renderer_adapt_fold(r, sum, n, &err);
+    }
+}
+
 static int on_progress(void *user, const cdl_progress *p)
 {
     char label[64];
@@ -125,6 +150,19 @@ int cli_render_mpi(int argc, char **argv, const char *cmdline)
     uint32_t spp;
     double budget;
     cdl_renderer_budget(r, &spp, &budget);
+    /* passes that adapt to earlier ones stay those of one process (spp budgets) */
+    size_t na = 0;
+    double *amine = NULL, *asum = NULL;
+    rc = spp ? cdl_renderer_adapt_size(r, &na, &err) : 0;
+    if (!rc && na && (!(amine = malloc(na * sizeof *amine)) || !(asum = malloc(na * sizeof *asum))))
+        err = (cdl_error){rc = CDL_ERR_SYSTEM, 0, "", "out of memory for the adaptive state"};
+    if ((status = agree(rc, &err))) {
+        free(amine);
+        free(asum);
+        cdl_renderer_release(r);
+        cdl_scene_release(scene);
+        return status;
+    }
     interrupted_render = r;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal); /* what mpirun sends the ranks on Ctrl-C */
@@ -140,6 +178,8 @@ int cli_render_mpi(int argc, char **argv, const char *cmdline)
             break;
         if (index > UINT32_MAX)
             break;
+        if (spp)
+            fold_adaptive(r, amine, asum, na, (uint32_t)index);
         double tp = cli_now();
         rc = cdl_renderer_render_pass(r, (uint32_t)index, &err);
         last = cli_now() - tp;
@@ -150,6 +190,10 @@ int cli_render_mpi(int argc, char **argv, const char *cmdline)
             on_progress(&bar, &p);
         }
     }
+    if (spp)
+        fold_adaptive(r, amine, asum, na, spp - 1); /* the folds the others still make */
+    free(amine);
+    free(asum);
     cli_bar_end(&bar);
     double t_render = cli_now() - t0;
     int pass_failed = rc ? (err.code == CDL_ERR_USAGE ? 2 : 1) : 0;
@@ -164,14 +208,8 @@ int cli_render_mpi(int argc, char **argv, const char *cmdline)
     if (ok)
         cdl_renderer_accum_get(r, mine, n, &err);
     MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    if (all_ok) {
-        /* in chunks: MPI counts are ints */
-        const size_t chunk = (size_t)1 << 26;
-        for (size_t off = 0; off < n; off += chunk) {
-            int m = (int)(n - off < chunk ? n - off : chunk);
-            MPI_Reduce(mine + off, sum ? sum + off : NULL, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-        }
-    }
+    if (all_ok)
+        sum_doubles(mine, sum, n, 0);
     t_comm = cli_now() - t_comm;
     double stats[3] = {t_comm, t_render, (double)cdl_renderer_passes(r)}, smax[3], smin[3];
     MPI_Reduce(stats, smax, 3, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);

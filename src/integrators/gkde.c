@@ -68,8 +68,10 @@ static int gkde_prepare(void *self, const cdl_scene *scene, const cdl_options *o
         s->at_infinity |= cdl_light_at_infinity(&scene->lights[i]);
     size_t npix = (size_t)opt->camera.width * (size_t)opt->camera.height;
     s->pv = calloc(npix * 6, sizeof *s->pv);
+    s->pv_new = calloc(npix * 6, sizeof *s->pv_new);
+    s->fold_at = 1;
     s->pixsum = malloc(npix * sizeof *s->pixsum);
-    if (!s->pv || !s->pixsum)
+    if (!s->pv || !s->pv_new || !s->pixsum)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
     s->g.cx = (cdl_connect_ctx){scene, &s->opt.camera, CDL_MIS_BALANCE, 0.0f, NULL, 0};
     s->g.n_light = (float)s->n_light;
@@ -406,12 +408,53 @@ static void fix_bandwidth(gkde_state *s)
     s->r_cap = s->h * u;
 }
 
+static size_t tally_size(const gkde_state *s)
+{
+    return 6 * (size_t)s->opt.camera.width * (size_t)s->opt.camera.height;
+}
+
+/* The tallies since the last fold join those the plans read. */
+static void fold(gkde_state *s, const double *sum)
+{
+    size_t n = tally_size(s);
+    for (size_t i = 0; i < n; i++) {
+        double v = (double)s->pv[i] + (sum ? sum[i] : (double)s->pv_new[i]);
+        s->pv[i] = v < 4294967295.0 ? (uint32_t)v : UINT32_MAX;
+    }
+    memset(s->pv_new, 0, n * sizeof *s->pv_new);
+    s->fold_at = s->fold_at > UINT32_MAX / 2 ? UINT32_MAX : 2 * s->fold_at;
+}
+
+static size_t gkde_adapt_size(const void *self)
+{
+    return tally_size(self);
+}
+
+static uint32_t gkde_adapt_next(const void *self)
+{
+    return ((const gkde_state *)self)->fold_at;
+}
+
+static void gkde_adapt_get(const void *self, double *out)
+{
+    const gkde_state *s = self;
+    for (size_t i = 0, n = tally_size(s); i < n; i++)
+        out[i] = (double)s->pv_new[i];
+}
+
+static void gkde_adapt_fold(void *self, const double *sum)
+{
+    fold(self, sum);
+}
+
 static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     gkde_state *s = self;
     s->cancel = film->cancel;
     double t0 = cdl_time_now();
     int rc = 0;
+    while (pass >= s->fold_at)
+        fold(s, NULL);
     if (!(s->r_cap > 0.0f) && pass != 0) {
         uint64_t rays = 0;
         if (!(rc = load_step(s, 0, &rays, err)) && !cdl_cancelled(s->cancel))
@@ -450,7 +493,7 @@ static int gkde_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error
     for (uint32_t q = 0; q < s->npts; q++) {
         uint32_t y = gkde_point_vertex(s, q);
         s->pixsum[s->epix[y]] = cdl_add(s->pixsum[s->epix[y]], s->acc[q]);
-        uint32_t *pv = &s->pv[gkde_pv_bucket(s, y)];
+        uint32_t *pv = &s->pv_new[gkde_pv_bucket(s, y)];
         pv[0] += s->tested[q];
         pv[1] += s->unocc[q];
         unocc += s->unocc[q];
@@ -529,6 +572,7 @@ static void gkde_destroy(void *self)
     free(s->acc);
     free(s->eye);
     free(s->pv);
+    free(s->pv_new);
     free(s->pixsum);
 }
 
@@ -540,5 +584,9 @@ const cdl_integrator_vtbl cdl_gkde_integrator = {
     .render_pass = gkde_render_pass,
     .destroy = gkde_destroy,
     .report = gkde_report,
+    .adapt_size = gkde_adapt_size,
+    .adapt_next = gkde_adapt_next,
+    .adapt_get = gkde_adapt_get,
+    .adapt_fold = gkde_adapt_fold,
     .self_size = sizeof(gkde_state),
 };

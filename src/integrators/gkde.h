@@ -67,8 +67,13 @@ typedef struct gkde_state {
     double *wsum, *scale, *cum;
     cdl_vec3 *acc;
     cdl_gkde_eye *eye; /* what links read of each point's eye vertex */
-    /* per pixel: tested and unoccluded links in earlier steps, by eye depth 1, 2, 3+ */
-    uint32_t *pv;
+    /* per pixel: tested and unoccluded links, by eye depth 1, 2, 3+: pv of the
+     * steps before fold_at (the plan reads these), pv_new of the steps since.
+     * Folding at powers of two makes step i's plan a function of steps
+     * [0, 2^floor(log2 i)) alone, so processes that render disjoint steps
+     * and sum pv_new at each fold get one process's plans. */
+    uint32_t *pv, *pv_new;
+    uint32_t fold_at;
     cdl_vec3 *pixsum;
     size_t rec_bytes;
     cdl_gkde_ctx g;

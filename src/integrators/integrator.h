@@ -121,6 +121,14 @@ typedef struct cdl_integrator_vtbl {
     int (*render_pass)(void *self, cdl_film *film, uint32_t pass, cdl_error *err);
     void (*destroy)(void *self);
     void (*report)(const void *self, cdl_stats *out); /* optional: statistics after rendering */
+    /* Optional, for methods whose passes adapt to earlier ones (gkde's
+     * visibility tallies): the state gathered since the last fold (size,
+     * get), the pass index of the next fold, and the fold with the state
+     * summed over every process (cdl_renderer_adapt_*). */
+    size_t (*adapt_size)(const void *self);
+    uint32_t (*adapt_next)(const void *self);
+    void (*adapt_get)(const void *self, double *out);
+    void (*adapt_fold)(void *self, const double *sum);
     size_t self_size;
 } cdl_integrator_vtbl;
 
