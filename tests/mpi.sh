@@ -19,7 +19,7 @@ if ! "$candela" --version | grep -q MPI || ! command -v mpirun >/dev/null; then
 fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 # under the sanitizers: Open MPI does not free its own (dlopen'ed) state at exit
-export ASAN_OPTIONS="detect_leaks=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
 mpi="mpirun -np 2 --oversubscribe"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
