@@ -6,6 +6,7 @@
 #    steps, are kept equal by summing its tallies at each fold (and 3 ranks);
 #  - two 2-rank runs are bit-identical (every method);
 #  - shared light paths (rigi, bdpt --light-paths) are per pass and rank;
+#  - --time is the whole job's budget;
 #  - a bad scene: one error line, a non-zero exit;
 #  - SIGINT to mpirun: the ranks stop, rank 0 writes the passes done;
 #  - kill -9 of one rank: mpirun ends the job, non-zero, within seconds.
@@ -61,6 +62,13 @@ if awk -v d="$d" 'BEGIN {exit !(d <= 1e-5)}'; then ok "gkde: 3 ranks vs 1 proces
 else bad "gkde: 3 ranks vs 1 process, max relative difference $d (> 1e-5)"; fi
 check splat 3 -i splat --photons 20000
 head -1 "$tmp/a.out"
+
+# --time is the job's budget: every rank stops within it
+# shellcheck disable=SC2086
+$mpi "$candela" render "$scene" $cam --time 2 -o "$tmp/t.exr" >"$tmp/t.out" 2>&1
+secs=$(sed -n 's/.* spp in \([0-9.]*\) s.*/\1/p' "$tmp/t.out")
+if [ -s "$tmp/t.exr" ] && awk -v t="$secs" 'BEGIN {exit !(t > 1.0 && t <= 2.5)}'; then ok "--time 2: $(cat "$tmp/t.out")"
+else bad "--time 2: $(cat "$tmp/t.out")"; fi
 
 # a bad scene: one error line from the ranks, a non-zero exit
 $mpi "$candela" render "$tmp/nosuch.obj" --spp 2 -o "$tmp/x.exr" >"$tmp/e.out" 2>"$tmp/e.err"
