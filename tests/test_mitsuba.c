@@ -27,15 +27,7 @@ static char dir[200];
 
 static void write_file(const char *name, const char *text)
 {
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        perror(path);
-        exit(2);
-    }
-    fputs(text, f);
-    fclose(f);
+    test_write(dir, name, text, strlen(text));
 }
 
 static int load_path(const char *path, cdl_scene *s, cdl_scene_settings *set)

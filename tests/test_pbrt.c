@@ -23,15 +23,7 @@ static char dir[200];
 
 static void write_file(const char *name, const char *text)
 {
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        perror(path);
-        exit(2);
-    }
-    fputs(text, f);
-    fclose(f);
+    test_write(dir, name, text, strlen(text));
 }
 
 /* Loads dir/name; prints and returns the status. */

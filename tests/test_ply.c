@@ -190,11 +190,7 @@ static int nfiles;
 
 static void write_file(const char *path, const void *d, size_t n)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(d, 1, n, f) != n || fclose(f)) {
-        fprintf(stderr, "cannot write %s\n", path);
-        exit(2);
-    }
+    test_write(NULL, path, d, n);
     nfiles++;
 }
 

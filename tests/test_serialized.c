@@ -209,11 +209,7 @@ static char tmpdir[256];
 
 static void write_file(const char *path, const void *d, size_t n)
 {
-    FILE *fp = fopen(path, "wb");
-    if (!fp || (n && fwrite(d, 1, n, fp) != n) || fclose(fp)) {
-        perror(path);
-        exit(2);
-    }
+    test_write(NULL, path, d, n);
 }
 
 static void print_err(int rc, const cdl_error *err)

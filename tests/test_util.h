@@ -20,6 +20,18 @@ static int test_failures = 0;
             test_failures++;                                                                       \
     } while (0)
 
+/* Writes n bytes to dir/name (dir NULL: name is the path); exits on failure. */
+static inline void test_write(const char *dir, const char *name, const void *data, size_t n)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s%s%s", dir ? dir : "", dir ? "/" : "", name);
+    FILE *f = fopen(path, "wb");
+    if (!f || (n && fwrite(data, 1, n, f) != n) || fclose(f)) {
+        perror(path);
+        exit(2);
+    }
+}
+
 static inline void die_on(int rc, const cdl_error *err)
 {
     if (rc) {
