@@ -284,6 +284,50 @@ class Renderer(_Handle):
         """n more passes, whatever the budget."""
         return self._run(lib.cdl_renderer_render_passes, int(n), progress=progress)
 
+    def render_pass(self, index):
+        """Renders the pass with this index (deterministic given the seed and
+        the index) as one more pass: several processes can render disjoint
+        passes of one render (see accumulators)."""
+        _call(lib.cdl_renderer_render_pass, self.h, int(index))
+        return self
+
+    @property
+    def accumulators(self):
+        """The film's sums, sample counts, splats and counters as a float64
+        vector; those of renders of disjoint passes add up (e.g. with mpi4py's
+        comm.reduce) and set back make this render that of all the passes."""
+        n = lib.cdl_renderer_accum_size(self.h)
+        out = np.zeros(n, dtype=np.float64)
+        _call(lib.cdl_renderer_accum_get, self.h, out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), n)
+        return out
+
+    @accumulators.setter
+    def accumulators(self, value):
+        a = np.ascontiguousarray(value, dtype=np.float64)
+        _call(lib.cdl_renderer_accum_set, self.h, a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), a.size)
+
+    def adapt_size(self):
+        """Size of the state a method adapts across passes (gkde), 0 if none."""
+        n = ctypes.c_size_t()
+        _call(lib.cdl_renderer_adapt_size, self.h, ctypes.byref(n))
+        return n.value
+
+    @property
+    def adapt_next(self):
+        """The pass index of the method's next fold (see candela.h)."""
+        return lib.cdl_renderer_adapt_next(self.h)
+
+    def adapt_get(self):
+        n = self.adapt_size()
+        out = np.zeros(n, dtype=np.float64)
+        _call(lib.cdl_renderer_adapt_get, self.h, out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), n)
+        return out
+
+    def adapt_fold(self, total):
+        """Folds the adaptive state summed over every process."""
+        a = np.ascontiguousarray(total, dtype=np.float64)
+        _call(lib.cdl_renderer_adapt_fold, self.h, a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), a.size)
+
     def cancel(self):
         """Stops the render after its current pass (from any thread)."""
         lib.cdl_renderer_cancel(self.h)

@@ -4,7 +4,7 @@ import ctypes
 import ctypes.util
 import os
 
-c_int, c_uint32, c_double, c_float = ctypes.c_int, ctypes.c_uint32, ctypes.c_double, ctypes.c_float
+c_int, c_uint32, c_double, c_float, c_size_t = ctypes.c_int, ctypes.c_uint32, ctypes.c_double, ctypes.c_float, ctypes.c_size_t
 c_char_p, c_void_p, c_size_t = ctypes.c_char_p, ctypes.c_void_p, ctypes.c_size_t
 
 
@@ -87,6 +87,14 @@ _sig = {
     "cdl_renderer_release": (None, [c_void_p]),
     "cdl_renderer_render": (c_int, [c_void_p, PROGRESS_FN, c_void_p, P(Error)]),
     "cdl_renderer_render_passes": (c_int, [c_void_p, c_uint32, PROGRESS_FN, c_void_p, P(Error)]),
+    "cdl_renderer_render_pass": (c_int, [c_void_p, c_uint32, P(Error)]),
+    "cdl_renderer_accum_size": (c_size_t, [c_void_p]),
+    "cdl_renderer_accum_get": (c_int, [c_void_p, P(c_double), c_size_t, P(Error)]),
+    "cdl_renderer_accum_set": (c_int, [c_void_p, P(c_double), c_size_t, P(Error)]),
+    "cdl_renderer_adapt_size": (c_int, [c_void_p, P(c_size_t), P(Error)]),
+    "cdl_renderer_adapt_next": (c_uint32, [c_void_p]),
+    "cdl_renderer_adapt_get": (c_int, [c_void_p, P(c_double), c_size_t, P(Error)]),
+    "cdl_renderer_adapt_fold": (c_int, [c_void_p, P(c_double), c_size_t, P(Error)]),
     "cdl_renderer_cancel": (None, [c_void_p]),
     "cdl_renderer_cancelled": (c_int, [c_void_p]),
     "cdl_renderer_passes": (c_uint32, [c_void_p]),

@@ -143,6 +143,33 @@ def test_incremental_passes_equal_one_render(box):
     assert np.array_equal(img, candela.render(box, integrator="bdpt", res=(32, 32), spp=4, seed=5, **CAM))
 
 
+@pytest.mark.parametrize("integ", ["path", "gkde"])
+def test_disjoint_passes_add_up(box, integ):
+    """Two renderers with the odd and even passes, their accumulators summed
+    (and gkde's adaptive tallies summed at each fold, as the MPI driver does),
+    make the 6-pass render."""
+    opts = dict(integrator=integ, res=(24, 24), seed=3, threads=1, **CAM)
+    if integ == "gkde":
+        opts["light_paths"] = 5000
+    rs = [candela.Renderer(box, **opts) for _ in range(2)]
+    sizes = [r.adapt_size() for r in rs]
+    assert sizes[0] == sizes[1] and (sizes[0] > 0) == (integ == "gkde")
+    for p in range(6):
+        if sizes[0]:
+            while rs[0].adapt_next <= p:
+                total = rs[0].adapt_get() + rs[1].adapt_get()
+                for r in rs:
+                    r.adapt_fold(total)
+        rs[p % 2].render_pass(p)
+    total = rs[0].accumulators + rs[1].accumulators
+    rs[0].accumulators = total
+    assert rs[0].passes == 6
+    img = rs[0].image()
+    for r in rs:
+        r.close()
+    assert np.array_equal(img, candela.render(box, spp=6, **opts))
+
+
 def test_stats_and_report(box):
     img, st = candela.render(box, integrator="pm", res=(32, 32), spp=2, photons=5000, stats=True, **CAM)
     assert st["passes"] == 2 and st["rays"] > 32 * 32 * 2 and st["seconds"] > 0
