@@ -182,6 +182,32 @@ static void materials_and_include(void)
     cdl_scene_free(&s);
 }
 
+/* An OBJ shape's uvs: as the file has them by default (Mitsuba flips v and
+ * looks textures up from the top: candela's convention), flipped with
+ * flip_tex_coords false. */
+static void obj_uvs(void)
+{
+    write_file("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0.25\nvt 1 0.25\nvt 0 1\nf 1/1 2/2 3/3\n");
+    for (int flip = 0; flip < 2; flip++) {
+        char xml[512];
+        snprintf(xml, sizeof xml,
+                 "<scene version=\"3.0.0\">\n" LIGHT "<shape type=\"obj\"><string name=\"filename\" value=\"tri.obj\"/>"
+                 "%s</shape>\n</scene>\n",
+                 flip ? "<boolean name=\"flip_tex_coords\" value=\"false\"/>" : "");
+        write_file("obj.xml", xml);
+        cdl_scene s;
+        cdl_scene_settings set;
+        if (load("obj.xml", &s, &set)) {
+            CHECK(0, "obj.xml loads");
+            return;
+        }
+        float v0 = s.uv[1];
+        CHECK(s.nverts == 3 && fabsf(v0 - (flip ? 0.75f : 0.25f)) < 1e-6f, "obj uv v %g with flip_tex_coords %s",
+              (double)v0, flip ? "false" : "true (default)");
+        cdl_scene_free(&s);
+    }
+}
+
 /* Each texel of an 8 x 4 map is seen in Mitsuba's direction for it:
  * local d = (sin phi sin theta, cos theta, -cos phi sin theta) with
  * phi = 2 pi u, theta = pi v, turned by to_world. */
@@ -286,6 +312,7 @@ int main(int argc, char **argv)
     }
     camera_and_transforms();
     materials_and_include();
+    obj_uvs();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

@@ -101,7 +101,13 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
     if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
         return rc;
     if (!strcmp(type, "obj")) {
-        rc = cdl_obj_read_mesh(path, m, c->err);
+        int flip_uv;
+        /* Mitsuba flips an OBJ's v by default: that is candela's convention;
+         * flip_tex_coords false keeps the file's v, so candela flips it */
+        if ((rc = cdl_mts_bool(c, n, "flip_tex_coords", 1, &flip_uv)) || (rc = cdl_obj_read_mesh(path, m, c->err)))
+            return rc;
+        for (uint32_t i = 0; !flip_uv && m->uv && i < m->nverts; i++)
+            m->uv[2 * i + 1] = 1.0f - m->uv[2 * i + 1];
     } else if (!strcmp(type, "ply")) {
         rc = cdl_ply_read(path, m, c->err);
     } else {
@@ -215,7 +221,7 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         /* cdl_scene_add_mesh flips mirrored meshes without normals (pbrt's
          * rule); cancel that, Mitsuba keeps the transformed winding */
         int reverse = flip ^ cdl_mat4_swaps_handedness(&m);
-        static const char *const quiet[] = {"filename", "shape_index", "face_normals", "flip_tex_coords"};
+        static const char *const quiet[] = {"filename", "shape_index", "face_normals"};
         for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++)
             cdl_mts_prop(c, n, quiet[i]);
         cdl_mts_warn_unused(c, n, type);
