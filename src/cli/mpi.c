@@ -197,8 +197,11 @@ int cli_render_mpi(int argc, char **argv, const char *cmdline)
     cli_bar_end(&bar);
     double t_render = cli_now() - t0;
     int pass_failed = rc ? (err.code == CDL_ERR_USAGE ? 2 : 1) : 0;
-    if (rc)
-        dprintf(err_fd, "candela: error: rank %d: pass failed\n", rank);
+    if (rc) { /* the passes done so far still count */
+        char buf[2048];
+        cdl_error_format(&err, buf, sizeof buf);
+        dprintf(err_fd, "candela: error: rank %d: %s\n", rank, buf);
+    }
 
     /* the sum of every rank's accumulators on rank 0 */
     double t_comm = cli_now();
