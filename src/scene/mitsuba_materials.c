@@ -284,9 +284,12 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     } else {
         cdl_mts_warn(c, n->line, "bsdf \"%s\" is not supported: rendered as diffuse", type);
         m = cdl_material_default(CDL_MAT_DIFFUSE);
+        /* the base colour under its usual names (principled: base_color) */
         cdl_xml_node *p = cdl_mts_prop(c, n, "reflectance");
         if (!p)
             p = cdl_mts_prop(c, n, "diffuse_reflectance");
+        if (!p)
+            p = cdl_mts_prop(c, n, "base_color");
         if (p)
             p->used = 0;
         if (p && color(c, n, cdl_xml_attr_get(p, "name"), m.kd, &m.kd, &m.kd_tex))
