@@ -14,6 +14,7 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->eta = m->eta;
     b->eta3 = m->eta3;
     b->k3 = m->k3;
+    b->fresnel = m->fresnel;
     /* below ~1e-4 the GGX lobe underflows in float */
     b->ax = cdl_maxf(m->alpha_x, 1e-4f);
     b->ay = cdl_maxf(m->alpha_y, 1e-4f);
@@ -58,12 +59,15 @@ static int is_opaque(const cdl_bsdf *b)
 
 /* Opaque materials are two-sided: both directions are mirrored to the
  * side wo is on. Returns 0 if wo and wi lie on different geometric sides
- * (light leaking through a surface is never reflected). */
+ * (light leaking through a surface is never reflected) or either grazes
+ * it. */
 static int opaque_local(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi,
                         cdl_vec3 *lo, cdl_vec3 *li)
 {
     float go = cdl_dot(wo, b->ng), gi = cdl_dot(wi, b->ng);
-    if (go * gi <= 0.0f)
+    /* within 1e-6 of the plane the side is rounding: two points of one
+     * sheet of zero thickness, one on each side, must not connect */
+    if (go * gi <= 0.0f || fabsf(go) < 1e-6f || fabsf(gi) < 1e-6f)
         return 0;
     *lo = cdl_to_local(&b->frame, wo);
     *li = cdl_to_local(&b->frame, wi);
@@ -298,7 +302,7 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
         if (cdl_dot(wo, b->ng) < 0.0f)
             n = cdl_neg(n);
         s->wi = cdl_reflect(wo, n);
-        s->weight = b->ks;
+        s->weight = b->fresnel ? cdl_mul(b->ks, cdl_fresnel_conductor(fabsf(cdl_dot(wo, n)), b->eta3, b->k3)) : b->ks;
         s->pdf = 1.0f;
         s->delta = 1;
         return cdl_dot(s->wi, b->ng) * cdl_dot(wo, b->ng) > 0.0f;

@@ -9,7 +9,8 @@
 typedef enum cdl_mat_type {
     CDL_MAT_DIFFUSE,         /* Lambert: kd */
     CDL_MAT_PHONG,           /* Lambert kd + normalized Phong lobe ks, exponent ns (MTL) */
-    CDL_MAT_MIRROR,          /* ideal specular reflection, reflectance ks */
+    CDL_MAT_MIRROR,          /* ideal specular reflection, reflectance ks (times the conductor
+                              * Fresnel term of eta3 + i k3 with `fresnel`) */
     CDL_MAT_DIELECTRIC,      /* smooth glass of index eta; reflectance ks, transmittance kt */
     CDL_MAT_CONDUCTOR,       /* GGX microfacet metal: complex index eta3 + i k3, roughness alpha */
     CDL_MAT_PLASTIC,         /* Lambert kd + GGX dielectric reflection ks (index eta), as pbrt-v3 */
@@ -30,6 +31,7 @@ typedef struct cdl_material {
     float eta;        /* index of refraction (dielectric, plastic coat) */
     cdl_vec3 eta3, k3; /* conductor: complex index of refraction per channel */
     float alpha_x, alpha_y; /* GGX roughness (alpha, not pbrt's "roughness") */
+    int fresnel;      /* mirror: reflectance ks times the conductor Fresnel term */
     char name[64];
 } cdl_material;
 
@@ -42,6 +44,23 @@ static inline float cdl_phong_energy_scale(const cdl_material *m)
     worst = worst > m->kd.y + m->ks.y * lobe ? worst : m->kd.y + m->ks.y * lobe;
     worst = worst > m->kd.z + m->ks.z * lobe ? worst : m->kd.z + m->ks.z * lobe;
     return worst > 1.0f ? 1.0f / worst : 1.0f;
+}
+
+/* Below this GGX alpha a conductor is a mirror (pbrt-v4's "effectively
+ * smooth"): a lobe that narrow is reached by BSDF sampling alone, and a
+ * method that connects to it (point lights, splats, merges) would see it
+ * black or as fireflies. */
+#define CDL_SMOOTH_ALPHA 1e-3f
+
+/* A material as the scene stores it: an effectively smooth conductor
+ * becomes a mirror with the conductor's Fresnel term. */
+static inline cdl_material cdl_material_canonical(cdl_material m)
+{
+    if (m.type == CDL_MAT_CONDUCTOR && m.alpha_x < CDL_SMOOTH_ALPHA && m.alpha_y < CDL_SMOOTH_ALPHA) {
+        m.type = CDL_MAT_MIRROR;
+        m.fresnel = 1;
+    }
+    return m;
 }
 
 /* A material with every field at its neutral default. */

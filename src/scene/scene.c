@@ -136,7 +136,7 @@ int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cd
 {
     if (cdl_grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for materials");
-    s->mats[s->nmats] = *m;
+    s->mats[s->nmats] = cdl_material_canonical(*m);
     *id = s->nmats++;
     return 0;
 }
