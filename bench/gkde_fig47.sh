@@ -34,10 +34,10 @@ key() { tr -s ' ' '\n' | awk -v k="$1" 'p {print; exit} $0 == k {p = 1}'; }
 cam=($(cat "$here/scenes/generated/grazing.cam"))
 g=("$here/scenes/generated/grazing.obj" "${cam[@]}" --res 320x240 --maxdepth 8)
 [ -f "$out/grazing_ref.exr" ] || "$candela" render "${g[@]}" -i path --spp "$refspp" -q -o "$out/grazing_ref.exr"
-"$candela" render "${g[@]}" -i gkde --spp "$steps" -o "$out/grazing_gkde.exr" | tee "$out/grazing_gkde.log"
+"$candela" render "${g[@]}" -i gkde --progressive off --overlaps 5 --spp "$steps" -o "$out/grazing_gkde.exr" | tee "$out/grazing_gkde.log"
 h=$(grep -o 'gkde: h [0-9.e-]*' "$out/grazing_gkde.log" | awk '{print $3}')
 h4=$(awk -v h="$h" 'BEGIN {print h / 4}')
-"$candela" render "${g[@]}" -i gkde --bandwidth "$h4" --spp $((16 * steps)) -o "$out/grazing_gkde_h4.exr" |
+"$candela" render "${g[@]}" -i gkde --progressive off --overlaps 5 --bandwidth "$h4" --spp $((16 * steps)) -o "$out/grazing_gkde_h4.exr" |
   tee "$out/grazing_gkde_h4.log"
 {
   echo "## Figure 4: grazing light (320x240, maxdepth 8, path reference $refspp spp)"
@@ -55,7 +55,7 @@ h4=$(awk -v h="$h" 'BEGIN {print h / 4}')
 # Cornell bias map
 # shellcheck disable=SC2054 # the commas are within --lookat
 cb=("$shared/scenes/cornell-box-mcguire/CornellBox-Original.obj" --lookat 0,1,3.9,0,1,0,0,1,0 --fov 39.3077 --res 256x256)
-"$candela" render "${cb[@]}" -i gkde --spp $((4 * steps)) -q -o "$out/cornell_gkde.exr"
+"$candela" render "${cb[@]}" -i gkde --progressive off --overlaps 5 --spp $((4 * steps)) -q -o "$out/cornell_gkde.exr"
 d=$("$candela" diff "$out/cornell_gkde.exr" "$shared/references/mcguire-cornell-original_path_256.exr" \
   --heatmap "$here/docs/gkde-bias-cornell.png")
 {
@@ -74,7 +74,7 @@ d=$("$candela" diff "$out/cornell_gkde.exr" "$shared/references/mcguire-cornell-
 gl=("$shared/scenes/cornell-box-mcguire/CornellBox-Glossy.obj" --lookat 0,1,3.9,0,1,0,0,1,0 --fov 39.3077 --res 160x160)
 [ -f "$out/glossy_ref.exr" ] || "$candela" render "${gl[@]}" -i path --spp "$refspp" -q -o "$out/glossy_ref.exr"
 for e in 1 4 16; do
-  "$candela" render "${gl[@]}" -i gkde --eye-paths $e --time "$budget" -o "$out/glossy_e$e.exr" > "$out/glossy_e$e.log"
+  "$candela" render "${gl[@]}" -i gkde --progressive off --overlaps 5 --eye-paths $e --time "$budget" -o "$out/glossy_e$e.exr" > "$out/glossy_e$e.log"
   d=$("$candela" diff "$out/glossy_e$e.exr" "$out/glossy_ref.exr")
   echo "| $e | $(grep -o '[0-9]* spp in' "$out/glossy_e$e.log" | awk '{print $1}') | $(echo "$d" | key relmse) |" \
     "$(echo "$d" | key mean_ratio) |" >> "$out/table.md"

@@ -22,7 +22,7 @@ mkdir -p "$out"
 [ -f "$out/building.obj" ] || /usr/bin/python3 "$here/scenes/generate.py" "$out" building
 cam=$(cat "$out/building.cam")
 # shellcheck disable=SC2086 # the camera file holds options
-"$candela" render "$out/building.obj" $cam --res "$res" -i gkde --spp "$steps" -o "$out/gkde.exr" -o "$out/gkde.png" |
+"$candela" render "$out/building.obj" $cam --res "$res" -i gkde --progressive off --overlaps 5 --spp "$steps" -o "$out/gkde.exr" -o "$out/gkde.png" |
   tee "$out/gkde.log"
 # shellcheck disable=SC2086
 [ -f "$out/ref.exr" ] || "$candela" render "$out/building.obj" $cam --res "$cres" -i path --spp "$refspp" -q -o "$out/ref.exr"

@@ -85,7 +85,7 @@ pm() {
   shift
   [ -f "$b.diff" ] && return 0
   # shellcheck disable=SC2086
-  "$candela" render "$scene" $cam --res $res --maxdepth $depth -i pm $direct $pmargs "$@" \
+  "$candela" render "$scene" $cam --res $res --maxdepth $depth -i pm --progressive off --visibility gather --knn 50 $direct $pmargs "$@" \
     -o "$b.pfm" -o "$b.png" > "$b.log" 2>&1
   "$candela" diff "$b.pfm" "$ref" > "$b.diff"
 }
@@ -198,7 +198,7 @@ hrel = float(re.search(r'relmse ([-+0-9.eE]+)', halves).group(1))
 w('Reference: `path`, %s, `--maxdepth 16`, %s spp as two halves (seeds 1 and 2); the relMSE between the '
   'halves is %.4g, so the reference carries about %.2g of relMSE itself (a quarter of that), which every '
   'pm value below includes.\n' % (res, refspp, hrel, hrel / 4))
-w('pm runs: `-i pm --res %s --maxdepth 16 --direct lcon --shadow-rays 32 %s--spp %s` (each pass traces a '
+w('pm runs: `-i pm --progressive off --visibility gather --knn 50 --res %s --maxdepth 16 --direct lcon --shadow-rays 32 %s--spp %s` (each pass traces a '
   'fresh map of --photons photons; the passes average), importance runs add `%s`. "maps MiB" is '
   'the peak of the maps in the `pm:` line: global map, the copy of its primary photons for L_con and, with '
   'final gathering, the precomputed irradiance (the same share of the global map in both methods).\n'

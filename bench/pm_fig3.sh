@@ -386,7 +386,7 @@ for seed in $(seq 1 "$seeds"); do
       fi
       echo "pm --caustic-select $sel --caustic-ratio $ql --photons $photons --spp $spp --seed $seed" >&2
       # shellcheck disable=SC2086
-      /usr/bin/time -f 'CPU %U %S' -a -o "$stem.log" "$candela" render "$scene" $cam --res "$res" -i pm \
+      /usr/bin/time -f 'CPU %U %S' -a -o "$stem.log" "$candela" render "$scene" $cam --res "$res" -i pm --progressive off --visibility gather --knn 50 \
         --knn 100 --gather 16 --shadow-rays 1 --photons "$photons" --caustic-ratio "$q" --caustic-select "$sel" --spp "$spp" --seed "$seed" \
         -o "$stem.pfm" -o "$stem.png" > "$stem.log" 2>&1
       echo "$sel $ql $q $seed $stem" >> "$runs"

@@ -28,11 +28,11 @@ for d in 8 1; do
   [ -f "$out/path_d$d.exr" ] || "$candela" render "${args[@]}" --maxdepth $d -i path --spp "$refspp" --seed 3 -q \
     -o "$out/path_d$d.exr"
 done
-"$candela" render "${args[@]}" -i splat --direct none --gather "$gather" --photons "$photons" -C 0.6 -S 0.2 -R 0.4 \
+"$candela" render "${args[@]}" -i splat --progressive off --occlusion off -C 1 --direct none --gather "$gather" --photons "$photons" -C 0.6 -S 0.2 -R 0.4 \
   --spp 1 -o "$out/rs-fg.exr" >"$out/rs-fg.log"
-"$candela" render "${args[@]}" -i pm --direct none --gather "$gather" --photons "$photons" --spp 1 \
+"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --direct none --gather "$gather" --photons "$photons" --spp 1 \
   -o "$out/pm-fg.exr" >"$out/pm-fg.log"
-"$candela" render "${args[@]}" -i pm --direct none --gather "$gather" --photons "$photons" --precompute 0 --spp 1 \
+"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --direct none --gather "$gather" --photons "$photons" --precompute 0 --spp 1 \
   -o "$out/pm-fg-knn.exr" >"$out/pm-fg-knn.log"
 /usr/bin/python3 - "$out" <<'PY'
 import re, sys

@@ -15,7 +15,7 @@ photons=${3:-200000}
 candela=${CANDELA:-$here/build/candela}
 mkdir -p "$out"
 "$candela" render "$here/../shared/scenes/cornell-box-mcguire/CornellBox-Sphere.obj" --lookat 0,1,3.9,0,1,0,0,1,0 \
-  --fov 39.3077 --res "${res}x$res" -i splat --photons "$photons" --spp 1 --aov bandwidth -o "$out/bw.exr"
+  --fov 39.3077 --res "${res}x$res" -i splat --progressive off --occlusion off -C 1 --photons "$photons" --spp 1 --aov bandwidth -o "$out/bw.exr"
 /usr/bin/python3 - "$out/bw.exr" "$here/docs/splat-fig44.png" <<'PY'
 import sys
 import numpy as np

@@ -19,7 +19,7 @@ candela=${CANDELA:-$here/build/candela}
 ref=$here/../shared/references/mcguire-cornell-original_path_256.exr
 mkdir -p "$out"
 args=("$here/../shared/scenes/cornell-box-mcguire/CornellBox-Original.obj" --lookat 0,1,3.9,0,1,0,0,1,0
-  --fov 39.3077 --res 256x256 -i splat --mode sh -C 0.6 -S 0.2 --photons "$photons" --spp 1)
+  --fov 39.3077 --res 256x256 -i splat --progressive off --occlusion off -C 1 --mode sh -C 0.6 -S 0.2 --photons "$photons" --spp 1)
 "$candela" render "${args[@]}" -o "$out/nocache.exr" >"$out/nocache.log"
 for sp in gradient geometric; do
   for w in report ward; do

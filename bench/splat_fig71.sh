@@ -23,8 +23,8 @@ echo "sweep,method,photons,res,seconds,mib,t_ray,t_light,t_build,t_solve,t_brdf"
 run() { # sweep method photons res
   local m=$1 p=$2 r=$3 args log
   case $m in
-    pm) args="-i pm --knn $k --gather 0 --direct photons" ;;
-    *) args="-i splat --mode $m --fractions 0.3,0.7,0 -C 1 -S 0.4 -R 0.2" ;;
+    pm) args="-i pm --progressive off --visibility gather --knn 50 --knn $k --gather 0 --direct photons" ;;
+    *) args="-i splat --progressive off --occlusion off -C 1 --mode $m --fractions 0.3,0.7,0 -C 1 -S 0.4 -R 0.2" ;;
   esac
   log="$out/$m-$p-$r.log"
   # shellcheck disable=SC2086 # options

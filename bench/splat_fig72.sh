@@ -47,11 +47,11 @@ for d in $depth 1; do
   [ -f "$out/path_d$d.exr" ] || "$candela" render "${args[@]}" --maxdepth $d -i path --spp "$refspp" --seed 3 -q \
     -o "$out/path_d$d.exr"
 done
-"$candela" render "${args[@]}" -i splat --direct none "${splat_opts[@]}" --photons "$photons" --spp "$passes" \
+"$candela" render "${args[@]}" -i splat --progressive off --occlusion off -C 1 --direct none "${splat_opts[@]}" --photons "$photons" --spp "$passes" \
   -o "$out/splat.exr" | tee "$out/splat.log"
-"$candela" render "${args[@]}" -i splat --direct none "${cache_opts[@]}" --photons "$photons" --spp "$passes" \
+"$candela" render "${args[@]}" -i splat --progressive off --occlusion off -C 1 --direct none "${cache_opts[@]}" --photons "$photons" --spp "$passes" \
   -o "$out/cache.exr" | tee "$out/cache.log"
-"$candela" render "${args[@]}" -i pm --direct none --gather 0 --knn "$k" --photons "$photons" --spp "$passes" \
+"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --direct none --gather 0 --knn "$k" --photons "$photons" --spp "$passes" \
   -o "$out/pm.exr" | tee "$out/pm.log"
 /usr/bin/python3 - "$out" "$png" "${SCENE:-sponza}" "$here/bench" <<'EOF'
 import sys

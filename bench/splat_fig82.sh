@@ -28,7 +28,7 @@ run() { # name maxdepth splat-options...
   local name=$1 d=$2
   shift 2
   for m in off on; do
-    "$candela" render "${args[@]}" --maxdepth "$d" -i splat --spp "$passes" --visibility-mask $m "$@" \
+    "$candela" render "${args[@]}" --maxdepth "$d" -i splat --progressive off --occlusion off -C 1 --spp "$passes" --visibility-mask $m "$@" \
       -o "$out/$name-$m.exr" >"$out/$name-$m.log"
   done
 }

@@ -43,17 +43,17 @@ EOF
 scene() { # name K pm-photons splat-args cache-args -- render args
   local name=$1 k=$2 m=$3 sargs=$4 cargs=$5
   shift 6
-  "$candela" render "$@" -i pm --photons "$m" --knn "$k" --gather 0 --direct photons --spp 1 -o "$out/$name-pm.exr" \
+  "$candela" render "$@" -i pm --progressive off --visibility gather --knn 50 --photons "$m" --knn "$k" --gather 0 --direct photons --spp 1 -o "$out/$name-pm.exr" \
     >"$out/$name-pm.log" 2>&1
   row "$name" "pm, $k nearest" "$out/$name-pm.log"
   for mode in histogram sh; do
     # shellcheck disable=SC2086 # options
-    "$candela" render "$@" -i splat --mode $mode --photons "$m" $sargs --spp 1 -o "$out/$name-$mode.exr" \
+    "$candela" render "$@" -i splat --progressive off --occlusion off -C 1 --mode $mode --photons "$m" $sargs --spp 1 -o "$out/$name-$mode.exr" \
       >"$out/$name-$mode.log" 2>&1
     row "$name" "splat $mode" "$out/$name-$mode.log"
   done
   # shellcheck disable=SC2086 # options
-  "$candela" render "$@" -i splat --mode sh --photons "$m" $sargs $cargs --cache 0.5 --spp 1 -o "$out/$name-cache.exr" \
+  "$candela" render "$@" -i splat --progressive off --occlusion off -C 1 --mode sh --photons "$m" $sargs $cargs --cache 0.5 --spp 1 -o "$out/$name-cache.exr" \
     >"$out/$name-cache.log" 2>&1
   row "$name" "splat sh cache ($cargs)" "$out/$name-cache.log"
 }

@@ -150,7 +150,7 @@ static void density(void)
     CHECK(top.n == (uint32_t)(G * G) && top.built, "photon map holds %u photons", top.n);
 
     uint32_t kmax = 400;
-    cdl_pm_query q = {0, 1.0f, CDL_KERNEL_BOX, 0, malloc(sizeof(uint32_t) * kmax), malloc(sizeof(float) * kmax), {0}, 0, NULL, 0};
+    cdl_pm_query q = {0, 1.0f, CDL_KERNEL_BOX, 0, malloc(sizeof(uint32_t) * kmax), malloc(sizeof(float) * kmax), {0}, 0, NULL, 0, 1.0f};
     /* k-NN noise: relative sd about 1/sqrt(k) for Poisson photons, less
      * for stratified ones. Measured (mean over 576 points / worst point):
      * k 25: box 2.2 / 23 %, cone 0.76 / 17 %, epanechnikov 0.82 / 19 %;
@@ -274,7 +274,7 @@ static void density(void)
     for (int ev = 0; ev < 2; ev++) {
         cdl_irr_map im;
         memset(&im, 0, sizeof im);
-        die_on(cdl_irr_build(&im, &both_s, &caus, every[ev], &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &both_s, &caus, every[ev], &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0, 1.0f}, &err), &err);
         double expect_n = (double)both_s.n / every[ev], sd_n = sqrt(expect_n);
         int nfound = 0;
         double worst_val = 0.0, mean_val = 0.0;
@@ -284,7 +284,7 @@ static void density(void)
                 for (int side = 0; side < 2; side++) {
                     cdl_vec3 n = side ? down : up, ex = side ? cdl_scale(Phi, 3.0f) : cdl_scale(Phi, 1.5f);
                     int found;
-                    cdl_vec3 got = cdl_irr_lookup(&im, x, n, 0.05f * 0.05f, novis, &found);
+                    cdl_vec3 got = cdl_irr_lookup(&im, x, n, n, 0.05f * 0.05f, 0, novis, &found);
                     nfound += found;
                     if (found) {
                         worst_val = fmax(worst_val, fabs(got.y / ex.y - 1.0));
@@ -305,14 +305,14 @@ static void density(void)
               "(limit 80%%)", every[ev], mean_val, 100 * worst_val);
         /* far from every point */
         int found;
-        cdl_irr_lookup(&im, cdl_v3(5.0f, 5.0f, 0.0f), up, 0.01f, novis, &found);
+        cdl_irr_lookup(&im, cdl_v3(5.0f, 5.0f, 0.0f), up, up, 0.01f, 0, novis, &found);
         CHECK(!found, "cdl_irr_lookup far away (1 in %u): found = %d", every[ev], found);
         cdl_irr_free(&im);
     }
     {
         cdl_irr_map im;
         memset(&im, 0, sizeof im);
-        CHECK(cdl_irr_build(&im, &both_s, &caus, 1, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err) == CDL_ERR_USAGE,
+        CHECK(cdl_irr_build(&im, &both_s, &caus, 1, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0, 1.0f}, &err) == CDL_ERR_USAGE,
               "cdl_irr_build with every = 1 is a usage error");
     }
     /* one-sided: the opposite normal (or a perpendicular one) finds nothing */
@@ -322,16 +322,16 @@ static void density(void)
         cdl_photon_map nocaus;
         cdl_pmap_init(&nocaus);
         die_on(cdl_pmap_build(&nocaus, &err), &err);
-        die_on(cdl_irr_build(&im, &top_s, &nocaus, 2, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_BOX, 0, NULL, NULL, novis, 0, NULL, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &top_s, &nocaus, 2, &(cdl_pm_query){100, 1.0f, CDL_KERNEL_BOX, 0, NULL, NULL, novis, 0, NULL, 0, 1.0f}, &err), &err);
         int any_down = 0, any_side = 0, all_up = 1;
         for (uint32_t i = 0; i < top_s.n; i += 17) {
             cdl_vec3 x = cdl_v3(top_s.ph[i].p[0], top_s.ph[i].p[1], top_s.ph[i].p[2]);
             int f;
-            cdl_irr_lookup(&im, x, down, 1.0f, novis, &f);
+            cdl_irr_lookup(&im, x, down, down, 1.0f, 0, novis, &f);
             any_down |= f;
-            cdl_irr_lookup(&im, x, cdl_v3(1.0f, 0.0f, 0.0f), 1.0f, novis, &f);
+            cdl_irr_lookup(&im, x, cdl_v3(1.0f, 0.0f, 0.0f), cdl_v3(1.0f, 0.0f, 0.0f), 1.0f, 0, novis, &f);
             any_side |= f;
-            cdl_irr_lookup(&im, x, up, 1.0f, novis, &f);
+            cdl_irr_lookup(&im, x, up, up, 1.0f, 0, novis, &f);
             all_up &= f;
         }
         CHECK(!any_down && !any_side && all_up,
@@ -383,21 +383,21 @@ static void sparse(void)
         for (int kern = 0; kern < 2; kern++) {
             cdl_irr_map im;
             memset(&im, 0, sizeof im);
-            die_on(cdl_irr_build(&im, &pm, &none, 4, &(cdl_pm_query){50, 0.01f, kern ? CDL_KERNEL_BOX : CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0}, &err),
+            die_on(cdl_irr_build(&im, &pm, &none, 4, &(cdl_pm_query){50, 0.01f, kern ? CDL_KERNEL_BOX : CDL_KERNEL_CONE, 0, NULL, NULL, novis, 0, NULL, 0, 1.0f}, &err),
                    &err);
             for (int j = 0; j < 16; j++)
                 for (int i = 0; i < 16; i++) {
                     cdl_vec3 x = cdl_v3(0.15f + 0.7f * (i + 0.5f) / 16.0f, 0.15f + 0.7f * (j + 0.5f) / 16.0f, 0.0f);
                     int found;
-                    cdl_vec3 E = cdl_irr_lookup(&im, x, up, 1.0f, novis, &found);
+                    cdl_vec3 E = cdl_irr_lookup(&im, x, up, up, 1.0f, 0, novis, &found);
                     if (found) {
                         sum[kern] += E.y / Phi.y;
                         cnt[kern]++;
                     }
                     if (!kern) {
                         /* as pm does it: a point within 0.05, else the photons */
-                        E = cdl_irr_lookup(&im, x, up, 0.05f * 0.05f, novis, &found);
-                        cdl_pm_query q = {50, 0.01f, CDL_KERNEL_BOX, 0, qi, qd, novis, 0, NULL, 0};
+                        E = cdl_irr_lookup(&im, x, up, up, 0.05f * 0.05f, 0, novis, &found);
+                        cdl_pm_query q = {50, 0.01f, CDL_KERNEL_BOX, 0, qi, qd, novis, 0, NULL, 0, 1.0f};
                         double Ee = found ? E.y : cdl_pmap_irradiance(&im.est, &q, x, up).y;
                         double Ea = found ? E.y : cdl_pmap_irradiance(&pm, &q, x, up).y;
                         fb_est += Ee / Phi.y;
@@ -429,10 +429,16 @@ static void sparse(void)
 
 /* ---- a wall at x = 0.5 standing on the square (the visibility test) ---- */
 
-static int wall_vis(const void *ctx, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np)
+static cdl_vec3 wall_origin(const void *ctx, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 wx, float lift)
 {
-    (void)ctx, (void)nx, (void)np;
-    return (x.x < 0.5f) == (p.x < 0.5f);
+    (void)ctx, (void)wx;
+    return cdl_madd(x, nx, lift);
+}
+
+static int wall_vis(const void *ctx, cdl_vec3 o, cdl_vec3 p, cdl_vec3 wp)
+{
+    (void)ctx, (void)wp;
+    return (o.x < 0.5f) == (p.x < 0.5f);
 }
 
 /* The right half is 20x brighter. Left of the wall an estimate with the
@@ -443,7 +449,7 @@ static void wall(void)
     cdl_error err;
     rng_state = 4242;
     const cdl_vec3 Phi = cdl_v3(1.0f, 1.0f, 1.0f), up = cdl_v3(0.0f, 0.0f, 1.0f);
-    const cdl_vis vis = {wall_vis, NULL}, novis = {0};
+    const cdl_vis vis = {wall_origin, wall_vis, NULL}, novis = {0};
     cdl_photon_map m, none;
     cdl_pmap_init(&m);
     cdl_pmap_init(&none);
@@ -455,7 +461,7 @@ static void wall(void)
     die_on(cdl_pmap_build(&none, &err), &err);
     const uint32_t k = 50;
     cdl_pm_query q = {k + 1, 1.0f, CDL_KERNEL_CONE, 0, malloc(sizeof(uint32_t) * (k + 1)),
-                      malloc(sizeof(float) * (k + 1)), vis, 0, NULL, 0};
+                      malloc(sizeof(float) * (k + 1)), vis, 0, NULL, 0, 1.0f};
     double worst_vis = 0.0, worst_novis = 0.0, worst_lookup = 0.0, worst_lookup_novis = 0.0;
     int found_all = 1;
     for (int pass = 0; pass < 2; pass++) {
@@ -463,13 +469,13 @@ static void wall(void)
         memset(&im, 0, sizeof im);
         q.vis = pass ? novis : vis;
         q.k = k;
-        die_on(cdl_irr_build(&im, &m, &none, 2, &(cdl_pm_query){k, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, q.vis, 0, NULL, 0}, &err), &err);
+        die_on(cdl_irr_build(&im, &m, &none, 2, &(cdl_pm_query){k, 1.0f, CDL_KERNEL_CONE, 0, NULL, NULL, q.vis, 0, NULL, 0, 1.0f}, &err), &err);
         for (int j = 0; j < 40; j++)
             for (int i = 0; i < 20; i++) {
                 cdl_vec3 x = cdl_v3(0.3f + 0.2f * (i + 0.5f) / 20.0f, 0.2f + 0.6f * (j + 0.5f) / 40.0f, 0.0f);
                 double E = cdl_pmap_irradiance(&m, &q, x, up).y / Phi.y;
                 int found;
-                double El = cdl_irr_lookup(&im, x, up, 1.0f, q.vis, &found).y / Phi.y;
+                double El = cdl_irr_lookup(&im, x, up, up, 1.0f, 0, q.vis, &found).y / Phi.y;
                 found_all &= found;
                 if (pass) {
                     worst_novis = fmax(worst_novis, E);

@@ -251,7 +251,7 @@ static void point_light_square(void)
     /* irradiance estimate against I cos / r^2: photons from QMC paths lie
      * like Poisson points, so the k-NN noise is the textbook one */
     uint32_t k = 100;
-    cdl_pm_query q = {k, 0.1f * 0.1f, CDL_KERNEL_CONE, 0, malloc(sizeof(uint32_t) * k), malloc(sizeof(float) * k), {0}, 0, NULL, 0};
+    cdl_pm_query q = {k, 0.1f * 0.1f, CDL_KERNEL_CONE, 0, malloc(sizeof(uint32_t) * k), malloc(sizeof(float) * k), {0}, 0, NULL, 0, 1.0f};
     rect_ctx rc = {lp, 2.0 * I, {X0 + 0.3, X1 - 0.3, Z0 + 0.3, Z1 - 0.3}};
     rng_state = 99;
     knn_check(&g, &q, "point light over a rectangle", 1000, rect_E, &rc, 1.0);
@@ -435,7 +435,7 @@ static void furnace(void)
     /* irradiance at random points of the wall, normal inwards */
     uint32_t k = 200;
     cdl_pm_query q = {k, 0.2f * 0.2f, CDL_KERNEL_EPANECHNIKOV, 0, malloc(sizeof(uint32_t) * k),
-                      malloc(sizeof(float) * k), {0}, 0, NULL, 0};
+                      malloc(sizeof(float) * k), {0}, 0, NULL, 0, 1.0f};
     sphere_ctx sc = {&s, Pall / area};
     rng_state = 4242;
     knn_check(&g, &q, "furnace", 1000, sphere_E, &sc, 1.0);

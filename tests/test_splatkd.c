@@ -196,7 +196,7 @@ static void irradiance(float theta, float cap)
             for (int j = -150; j <= 150; j++) {
                 float a = ((float)i + cdl_rng_float(&r) - 0.5f) * g, b = ((float)j + cdl_rng_float(&r) - 0.5f) * g;
                 cdl_vec3 hit = cdl_v3(0.5f + a / cosf(theta), 0.0f, 0.5f + b);
-                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f, cap, 0.0f};
+                cdl_splat_ray ray = {cdl_sub(hit, cdl_scale(d, 2.0f)), d, cdl_v3(0, 0, 0), 2.0f, h, 0.0f, cap, 0.0f, 0.0f};
                 if (backside) { /* from below: the samples show their top */
                     ray.d = cdl_neg(d);
                     ray.o = cdl_add(hit, cdl_scale(d, 2.0f));
@@ -232,7 +232,7 @@ static void irradiance(float theta, float cap)
 static void sheet(void)
 {
     cdl_vec3 d = cdl_normalize(cdl_v3(0.3f, 0.0f, -1.0f));
-    cdl_splat_ray ray = {cdl_v3(0, 0, 0), d, cdl_v3(0, 0, -1), 1.0f, 0.2f, 0.0f, 4.0f, 1e-5f};
+    cdl_splat_ray ray = {cdl_v3(0, 0, 0), d, cdl_v3(0, 0, -1), 1.0f, 0.2f, 0.0f, 4.0f, 1e-5f, 0.0f};
     float z, front = cdl_splat_weight(&ray, cdl_v3(0.05f, 0.0f, 0.0f), cdl_v3(0, 0, 1), 0, &z);
     float wall = cdl_splat_weight(&ray, cdl_v3(0.05f, 0.0f, -1e-6f), cdl_v3(-1, 0, 0), 0, &z);
     ray.zmin = 0.0f;

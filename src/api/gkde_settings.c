@@ -4,7 +4,7 @@
 
 #include "api/parse.h"
 
-static const char *valued[] = {"--eye-paths", "--links", "--bandwidth", "--path-memory", "--footprint-cap"};
+static const char *valued[] = {"--eye-paths", "--links", "--bandwidth", "--path-memory", "--footprint-cap", "--overlaps"};
 
 int cdl_gkde_arg_kind(const char *o)
 {
@@ -31,6 +31,13 @@ int cdl_gkde_arg(const char *o, const char *v, cdl_gkde_options *g, cdl_error *e
     } else if (!strcmp(o, "--footprint-cap")) {
         rc = cdl_arg_float(o, v, 0.0, 1e6, &d, err);
         g->footprint_cap = (float)d;
+    } else if (!strcmp(o, "--overlaps")) {
+        rc = cdl_arg_float(o, v, 1.0, 1e4, &d, err);
+        if (!rc && !(d >= 2.0))
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                                 "must be at least 2: a point a footprint reaches lies in one at least, so "
+                                 "fewer cannot be calibrated to, got '%s'", v);
+        g->overlaps = (float)d;
     } else if (!strcmp(o, "--path-memory")) {
         rc = cdl_arg_int(o, v, 1, 1048576, &l, err);
         g->max_mib = (uint32_t)l;

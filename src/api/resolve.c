@@ -52,6 +52,8 @@ int cdl_settings_resolve(const cdl_settings *in, const cdl_scene *scene, cdl_set
     opt->clamp = (float)a->clamp;
     opt->strata_distance = a->strata_distance;
     opt->single_shadow_rays = a->single_shadow_rays;
+    opt->progressive = a->progressive;
+    opt->alpha = (float)a->alpha;
     opt->pm = a->pm;
     opt->gkde = a->gkde;
     opt->splat = a->splat;

@@ -27,6 +27,8 @@ static void defaults(cdl_settings *a)
     a->seed = 1;
     a->mis = CDL_MIS_POWER;
     a->interleave = 1;
+    a->progressive = 1;
+    a->alpha = 2.0 / 3.0;
 }
 
 cdl_settings *cdl_settings_create(void)
@@ -96,6 +98,13 @@ static int set(cdl_settings *a, const char *o, const char *v, cdl_error *err)
         if (f < 0)
             return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
         a->sink.quiet = f;
+        return 0;
+    }
+    if (!strcmp(o, "--progressive")) {
+        int f = flag_value(v);
+        if (f < 0)
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
+        a->progressive = f;
         return 0;
     }
     int pk = cdl_pm_arg_kind(o);
@@ -223,6 +232,12 @@ static int set(cdl_settings *a, const char *o, const char *v, cdl_error *err)
             a->pm.shadow_rays = (uint32_t)l;
         } else
             return cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected bundle, single or a ray count, got '%s'", v);
+    } else if (!strcmp(o, "--alpha")) {
+        rc = cdl_arg_float(o, v, 0.0, 1.0, &d, err);
+        if (!rc && !(d > 0.0 && d < 1.0))
+            return cdl_error_set(err, CDL_ERR_USAGE, o, 0,
+                                 "must be in (0, 1): 1 keeps the bandwidths fixed, 0 lets the noise grow, got '%s'", v);
+        a->alpha = d;
     } else if (!strcmp(o, "--exposure")) {
         rc = cdl_arg_float(o, v, -100.0, 100.0, &d, err);
         a->exposure = d;

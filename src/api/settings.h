@@ -30,6 +30,8 @@ struct cdl_settings {
     long light_paths, interleave;
     double threshold, clamp;
     int strata_distance, single_shadow_rays;
+    int progressive; /* pm, gkde, splat: bandwidths shrink with the pass index */
+    double alpha;    /* their schedule's alpha (Knaus & Zwicker 2011) */
     int aov_pathlength, aov_strata, aov_bandwidth, aov_records;
     cdl_pm_options pm;
     cdl_gkde_options gkde;

@@ -6,7 +6,7 @@
 
 static const char *valued[] = {"--fractions", "-C", "-S", "-R", "--mode", "--eye-samples", "--cull-nodes", "--cap",
                                "--traversal", "--filter", "--filter-normal", "--filter-depth", "--filter-max",
-                               "--cache", "--cache-min", "--cache-weight", "--cache-spacing", "--visibility-mask"};
+                               "--cache", "--cache-min", "--cache-weight", "--cache-spacing", "--visibility-mask", "--occlusion"};
 
 int cdl_splat_arg_kind(const char *o)
 {
@@ -94,6 +94,13 @@ int cdl_splat_arg(const char *o, const char *v, cdl_splat_options *sp, cdl_error
             sp->visibility_mask = 1;
         else if (!strcmp(v, "off"))
             sp->visibility_mask = 0;
+        else
+            rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
+    } else if (!strcmp(o, "--occlusion")) {
+        if (!strcmp(v, "on"))
+            sp->occlusion = 1;
+        else if (!strcmp(v, "off"))
+            sp->occlusion = 0;
         else
             rc = cdl_error_set(err, CDL_ERR_USAGE, o, 0, "expected on or off, got '%s'", v);
     } else if (!strcmp(o, "--traversal")) {

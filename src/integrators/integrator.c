@@ -1,5 +1,6 @@
 #include "integrators/integrator.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,8 +25,10 @@ void cdl_options_default(cdl_options *o)
     o->seed = 1;
     o->mis = CDL_MIS_POWER;
     o->interleave = 1;
+    o->progressive = 1;
+    o->alpha = 2.0f / 3.0f;
     o->pm.photons = 100000;
-    o->pm.k = 50;
+    o->pm.k = 20;
     o->pm.kernel = 1; /* cone */
     o->pm.gather = 8;
     o->pm.precompute = 4;
@@ -33,15 +36,17 @@ void cdl_options_default(cdl_options *o)
     o->pm.eps = 0.01f;
     o->pm.caustic_ratio = 1.0f;
     o->pm.shadow_rays = 4;
+    o->pm.visibility = CDL_PM_VIS_ALL;
     o->gkde.eye_paths = 1;
     o->gkde.links = 0; /* tied to the light paths (gkde.h) */
     o->gkde.footprint_cap = 2.0f;
+    o->gkde.overlaps = 2.0f;
     o->gkde.max_mib = 4096;
     o->splat.photons = 200000;
     o->splat.fractions[0] = 0.3f;
     o->splat.fractions[1] = 0.6f;
     o->splat.fractions[2] = 0.1f;
-    o->splat.C = 1.0f;
+    o->splat.C = 0.5f;
     o->splat.S = 0.4f;
     o->splat.R = 0.2f;
     o->splat.mode = CDL_SPLAT_DIRECT;
@@ -52,6 +57,15 @@ void cdl_options_default(cdl_options *o)
     o->splat.filter_max = 25;
     o->splat.cache_min = 5;
     o->splat.cap = 4.0f;
+    o->splat.occlusion = 1;
+}
+
+float cdl_progressive_r2(const cdl_options *opt, uint32_t pass)
+{
+    if (!opt->progressive || !pass)
+        return 1.0f;
+    double a = opt->alpha, i = pass;
+    return (float)exp(lgamma(i + 1.0 + a) - lgamma(1.0 + a) - lgamma(i + 2.0));
 }
 
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt)

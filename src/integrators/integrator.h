@@ -51,6 +51,8 @@ typedef struct cdl_gkde_options {
     uint32_t links;      /* M: unoccluded links wanted per eye vertex (§5); 0: one per 10000 light paths */
     float bandwidth;     /* h of eq. 7; <= 0: calibrated in the first step */
     float footprint_cap; /* footprint radii at most this times the median first-bounce one; 0: none */
+    float overlaps;      /* h_0 is calibrated so that an eye vertex in direct light lies in this many
+                          * first-bounce footprints (>= 2) */
     uint32_t max_mib;    /* cap on the stored path vertices (MiB) */
 } cdl_gkde_options;
 
@@ -77,6 +79,7 @@ typedef struct cdl_splat_options {
     int cache_geometric; /* record spacing from the harmonic mean distance alone (no irradiance gradient) */
     uint32_t gather;     /* §6.4: final-gather rays per camera sample, each an eye sample; 0: none */
     int visibility_mask; /* §8.1: eye samples hidden from a photon ray by others in its frustum get nothing */
+    int occlusion;       /* a splat counts only if a free segment joins the sample to the ray (exact) */
     float cap;           /* beyond a ray's hit: 0 the report's hemisphere, c > 0 the tangent-plane
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;
@@ -102,6 +105,11 @@ typedef struct cdl_options {
     int strata_distance;   /* rigi: threshold the distance instead of G (Figure 2c) */
     int single_shadow_rays; /* rigi/ir: trace shadow rays one by one instead of as bundles */
 
+    /* pm, gkde, splat: consistent by default, their bandwidths shrinking
+     * with the pass index (cdl_progressive_r2); off: the reports' fixed ones */
+    int progressive;
+    float alpha;
+
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;
@@ -112,6 +120,15 @@ typedef struct cdl_options {
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt);
 
 void cdl_options_default(cdl_options *o);
+
+/* Progressive radius reduction (Knaus & Zwicker 2011, eq. 20): the squared
+ * bandwidth of pass i (0-based) relative to pass 0's,
+ *   r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1)   (1-based i),
+ * i.e. prod_{j=1..i} (j + alpha) / (j + 1) = Gamma(i + 1 + alpha) /
+ * (Gamma(1 + alpha) Gamma(i + 2)), about i^(alpha - 1) / Gamma(1 + alpha).
+ * A function of the pass index alone, so that passes stay independent and
+ * can be split over processes. 1 when opt->progressive is off. */
+float cdl_progressive_r2(const cdl_options *opt, uint32_t pass);
 
 typedef struct cdl_integrator_vtbl {
     const char *name;

@@ -12,8 +12,17 @@
  *                   surface carry caustics: they are the caustic map's part);
  *                   --gather 0 queries the global map at x without its
  *                   primary photons (direct visualization).
- * Passes average progressively, so the bias of the density estimate
- * shrinks only with --photons; the noise with the passes. */
+ * Passes average. By default every estimate's radius (the k nearest's,
+ * within --max-radius) is scaled by the pass's factor of progressive
+ * photon mapping (Knaus & Zwicker 2011; cdl_progressive_r2), so the bias
+ * falls with the passes as the noise does. Their probabilistic form is the
+ * one that fits here: each pass is an independent estimate whose radius
+ * is a function of the pass index alone, so the same schedule serves the
+ * camera's point, the final-gather hits, the precomputed irradiance and
+ * the caustic map alike, and passes can still be split over processes;
+ * Hachisuka & Jensen's per-pixel statistics exist only for the camera's
+ * points. --progressive off: Jensen's fixed k-NN estimate, whose bias
+ * shrinks only with --photons. */
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,6 +48,7 @@ typedef struct pm_state {
     cdl_vis vis_gather, vis_camera; /* photon visibility tests, or none */
     cdl_direct_cfg dcfg;
     uint32_t traced_pass; /* pass whose photons the maps hold, or UINT32_MAX */
+    float shrink;         /* that pass's squared-radius factor (cdl_progressive_r2) */
     /* statistics */
     cdl_photon_stats last, sum;
     uint32_t passes;
@@ -54,6 +64,7 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
                                &st->global, &st->caustic, &st->last, err);
     if (rc)
         return rc;
+    st->shrink = cdl_progressive_r2(&st->opt, pass);
     if (st->dcfg.kind != CDL_DIRECT_POWER && st->dcfg.kind != CDL_DIRECT_NONE && !st->direct.built) {
         /* the primary photons of the first pass on their own, for the L_con
          * ball queries; kept for all passes: L_con then stays the same set at
@@ -78,7 +89,7 @@ static int trace(pm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
         /* for gather rays from the first vertex: the camera ray and the
          * gather ray leave maxdepth - 1 bounces to the photons */
         cdl_pm_query q = {st->opt.pm.k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, NULL, NULL,
-                          st->vis_gather, (uint32_t)st->opt.maxdepth - 1, NULL, 0};
+                          st->vis_gather, (uint32_t)st->opt.maxdepth - 1, NULL, 0, st->shrink};
         rc = cdl_irr_build(&st->irr, &st->global, &st->caustic, st->opt.pm.precompute, &q, err);
         if (rc)
             return rc;
@@ -128,7 +139,7 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
                              "cannot also estimate there");
     if (opt->pm.visibility < CDL_PM_VIS_GATHER || opt->pm.visibility > CDL_PM_VIS_OFF)
         return cdl_error_set(err, CDL_ERR_USAGE, "--visibility", 0, "unknown kind %d", opt->pm.visibility);
-    cdl_vis vis = {cdl_photon_visible, scene}, none = {0};
+    cdl_vis vis = {cdl_photon_vis_origin, cdl_photon_visible, scene}, none = {0};
     st->vis_gather = opt->pm.visibility != CDL_PM_VIS_OFF ? vis : none;
     st->vis_camera = opt->pm.visibility == CDL_PM_VIS_ALL ? vis : none;
     st->dcfg.kind = (cdl_direct_kind)opt->pm.direct;
@@ -253,7 +264,8 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
              * unless no photon went that deep */
             if (bg.type == CDL_MAT_DIFFUSE && st->irr.n && (depth == 0 || st->ph_depth <= left - 1)) {
                 cdl_vec3 n = cdl_dot(sg.ng, wg) < 0.0f ? cdl_neg(sg.ng) : sg.ng;
-                cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, st->max_r2, st->vis_gather, &found);
+                cdl_vec3 E = cdl_irr_lookup(&st->irr, sg.p, n, wg, st->max_r2, st->opt.progressive,
+                                            st->vis_gather, &found);
                 if (found)
                     Lg = cdl_add(Lg, cdl_mul(sc.weight, cdl_mul(bg.kd, cdl_scale(E, CDL_INV_PI))));
             }
@@ -274,7 +286,7 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
     scratch w;
     uint32_t k = st->opt.pm.k, cap = 4 * k;
     w.qg = (cdl_pm_query){k, st->max_r2, (cdl_kernel)st->opt.pm.kernel, 0, malloc(sizeof(uint32_t) * cap),
-                          malloc(sizeof(float) * cap), st->vis_gather, 0, NULL, cap};
+                          malloc(sizeof(float) * cap), st->vis_gather, 0, NULL, cap, st->shrink};
     w.qc = w.qg;
     w.qgx = w.qg;
     w.qgx.vis = st->vis_camera;

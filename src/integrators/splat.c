@@ -11,8 +11,11 @@
  *     is not splatted);
  *  2. the eye-sample kd-tree (spatial/splatkd.c, §5.1);
  *  3. light pass: photon rays with path-density bandwidths
- *     (transport/photon_rays.c, §4.2), the bandwidth's M growing with the
- *     passes so kernels shrink as M^(-1/6) and the average converges;
+ *     (transport/photon_rays.c, §4.2), every kernel scaled by the pass's
+ *     factor of the progressive schedule (cdl_progressive_r2: about
+ *     pass^(-1/6) at alpha 2/3, what eq. 4.9's M^(-1/6) gives when M grows
+ *     with the passes), so the average converges; --progressive off keeps
+ *     the report's bandwidths in every pass;
  *  4. every photon ray splats to the eye samples in its frustum
  *     (Algorithms 1, 2) into the radiance maps (splat_maps.c, §6.1);
  *  5. the BSDF applied to each sample's map gives the pass's image.
@@ -349,7 +352,7 @@ static size_t bytes(const splat_state *s)
 {
     return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
            cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
-           splat_mask_bytes(s) +
+           splat_mask_bytes(s) + splat_occl_bytes(s) +
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
 }
 
@@ -369,7 +372,7 @@ static int photon_rays(splat_state *s, cdl_film *film, uint32_t pass, cdl_error 
             return rc;
         s->have_pilot = 1;
     }
-    s->pp.m_scale = (double)pass + 1.0;
+    s->pp.bw_scale = sqrt((double)cdl_progressive_r2(&s->opt, pass));
     rc = cdl_pray_trace(s->scene, &s->walk, &s->pp, s->opt.sampler, s->opt.seed, pass, &s->rays, err);
     if (!rc)
         rc = sort_rays(s, err);
@@ -413,6 +416,11 @@ static int band(splat_state *s, cdl_film *film, uint32_t pass, int y0, int y1, c
         rc = build(s, err);
     double t2 = cdl_time_now();
     s->st.t_build += t2 - t1;
+    if (!rc && s->opt.splat.occlusion) {
+        rc = splat_occl_prepare(s, err);
+        s->st.t_occl += cdl_time_now() - t2;
+        t2 = cdl_time_now();
+    }
     if (rc || cdl_cancelled(s->cancel))
         return rc;
     if (s->opt.splat.cache > 0.0f) {
@@ -526,6 +534,15 @@ static void splat_report(const void *self, cdl_stats *out)
                t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
                t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);
+    if (s->occl) {
+        uint64_t all = t->splats + t->masked + t->occluded;
+        cdl_stats_printf(out, "splat: occlusion test: clearances %.2f s; %.1f %% of the splats needed a "
+                         "shadow ray, %.2f %% were occluded\n",
+                         t->t_occl, all ? 100.0 * (double)t->occl_rays / (double)all : 0.0,
+                         all ? 100.0 * (double)t->occluded / (double)all : 0.0);
+        cdl_stats_add(out, "t_occlusion", t->t_occl);
+        cdl_stats_add(out, "occlusion_rays", (double)t->occl_rays);
+    }
     if (s->opt.splat.filter > 0.0f)
         cdl_stats_printf(out, "splat: filter (in T_brdf) %.2f s, %.0f segments per pass\n", t->t_filter,
                (double)t->segments / P);
@@ -556,6 +573,7 @@ static void splat_destroy(void *self)
     free(s->bw);
     splat_cache_free(s);
     splat_mask_free(s);
+    splat_occl_free(s);
     free(s->tables);
 }
 

@@ -28,9 +28,10 @@ typedef struct splat_eye {
 } splat_eye;
 
 typedef struct splat_stats {
-    double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_total;
+    double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_occl, t_total;
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
     uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized, mask_rays;
+    uint64_t occluded, occl_rays; /* --occlusion: splats dropped, shadow rays traced */
     size_t peak_bytes;
 } splat_stats;
 
@@ -70,6 +71,7 @@ typedef struct splat_state {
     float *bw;        /* --aov bandwidth only: SPLAT_BW floats per sample */
     struct splat_cache *cache; /* --cache: radiance caching (splat_cache.c) */
     struct splat_mask *mask;   /* --visibility-mask (splat_mask.c) */
+    struct splat_occl *occl;   /* --occlusion (splat_occlusion.c) */
     int want_bw;
     cdl_vec3 strata[SPLAT_STRATA];
     cdl_sh_rot rot;
@@ -118,8 +120,8 @@ static inline cdl_splat_ray splat_ray_of(const splat_state *s, const cdl_photon_
      * sheet the ray left: they face it) lie within a hit point's offset
      * (cdl_offset) of its tangent plane; a point light has no surface */
     float m = cdl_maxf(fabsf(r->o.x), cdl_maxf(fabsf(r->o.y), fabsf(r->o.z)));
-    float zmin = cdl_is_black(r->on) ? 0.0f : s->scene->eps + m * 1e-5f;
-    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap, zmin};
+    float tol = s->scene->eps + m * 1e-5f, zmin = cdl_is_black(r->on) ? 0.0f : tol;
+    return (cdl_splat_ray){r->o, r->d, r->on, r->len, r->h0, r->dh, s->opt.splat.cap, zmin, tol};
 }
 /* The visibility mask (§8.1, splat_mask.c): the rays' occlusion buffers
  * built a batch at a time; filter drops from a batch's mask the samples
@@ -132,6 +134,17 @@ size_t splat_mask_bytes(const splat_state *s);
 int splat_mask_prepare(splat_state *s);
 int splat_mask_build(splat_state *s, uint32_t first, uint32_t n);
 uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, uint32_t mask, const float *iz);
+/* The occlusion test (splat_occlusion.c): each pass's eye samples get
+ * their clearance (prepare, after the tree is built); seen: whether sample
+ * q (tree order) sees the point of ray r it stands for (iz: one over its
+ * distance along the ray; a shadow ray counted in *rays when needed);
+ * filter: the lanes of a batch that do. */
+void splat_occl_free(splat_state *s);
+size_t splat_occl_bytes(const splat_state *s);
+int splat_occl_prepare(splat_state *s, cdl_error *err);
+int splat_occl_seen(const splat_state *s, const cdl_photon_ray *r, uint32_t q, float iz, uint64_t *rays);
+uint32_t splat_occl_filter(const splat_state *s, const cdl_photon_ray *r, uint32_t first, uint32_t mask,
+                           const float *iz, uint64_t *rays);
 /* Filters the maps in image space within surface segments (§6.2, splat_filter.c). */
 int splat_filter(splat_state *s, cdl_error *err);
 /* RGB of entry k (stratum or coefficient) of glossy sample g. */

@@ -131,6 +131,16 @@ static int record_hit(splat_state *s, splat_cache *c, splat_terms *t, const cdl_
                                     tr->two[q] > 0.0f ? CDL_SKD_TWO_SIDED : 0, &z, &g);
     if (!(w > 0.0f))
         return 0;
+    if (s->occl) {
+        uint64_t rays = 0;
+        int seen = splat_occl_seen(s, t->r, q, z > 0.0f ? 1.0f / z : 0.0f, &rays);
+        if (rays) {
+#pragma omp atomic
+            s->st.occl_rays += rays;
+        }
+        if (!seen)
+            return 0;
+    }
     splat_maps_add(s, t, q, w, z > 0.0f ? 1.0f / z : 0.0f);
     float lum = cdl_luminance(t->r->flux);
     c->grad[0][q] += lum * g.x;
@@ -396,9 +406,9 @@ static float record_radius(const splat_state *s, const splat_cache *c, uint32_t 
         if (gl > 0.0f && E < gl * R)
             R = E / gl > rmin ? E / gl : rmin;
     }
-    /* shrunk with the passes as the kernels are (eq. 4.9's M^(-1/6)):
-     * later passes take more records, and the average converges */
-    return s->opt.splat.cache * R * (float)pow(s->pp.m_scale, -1.0 / 6.0);
+    /* shrunk with the passes as the kernels are: later passes take more
+     * records, and the average converges */
+    return s->opt.splat.cache * R * (float)s->pp.bw_scale;
 }
 
 /* Eq. 6.7 (or Ward's weight) of record q (radius rr) at sample y. */

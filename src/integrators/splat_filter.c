@@ -93,9 +93,10 @@ int splat_filter(splat_state *s, cdl_error *err)
         for (uint32_t q = 0; q < s->neye; q++)
             count[s->eye[q].pixel] += s->nsum[q];
         /* a box holding N splats grows as the kernels shrink with the
-         * passes (splats per sample ~ M^(-1/3)); N (pass)^(-2/3) makes it
-         * shrink as the kernels do instead, so the average converges */
-        float want = o->filter * (float)pow(s->pp.m_scale, -2.0 / 3.0);
+         * passes (splats per sample ~ h^2); N h^4 makes it shrink as the
+         * kernels do instead, so the average converges */
+        double b2 = s->pp.bw_scale * s->pp.bw_scale;
+        float want = o->filter * (float)(b2 * b2);
         rc = cdl_segment_support(&sg, count, want, o->filter_max, rad, err);
         if (!rc)
             rc = filter_image(s, &sg, rad, 3, 0, err);

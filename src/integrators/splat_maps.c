@@ -185,7 +185,7 @@ typedef struct ray_ctx {
     splat_state *s;
     splat_terms t;
     uint32_t ray;
-    uint64_t splats, masked;
+    uint64_t splats, masked, occluded, occl_rays;
 } ray_ctx;
 
 /* The feasible glossy samples of a batch: the ray's light in their maps. */
@@ -228,6 +228,12 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     if (s->mask) {
         uint32_t seen = splat_mask_filter(s, c->ray, first, mask, iz);
         c->masked += (uint64_t)__builtin_popcount(mask & ~seen);
+        if (!(mask = seen))
+            return;
+    }
+    if (s->occl) {
+        uint32_t seen = splat_occl_filter(s, c->t.r, first, mask, iz, &c->occl_rays);
+        c->occluded += (uint64_t)__builtin_popcount(mask & ~seen);
         if (!(mask = seen))
             return;
     }
@@ -284,7 +290,7 @@ void splat_maps_clear(splat_state *s)
 int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
-    uint64_t splats = 0, tested = 0, nodes = 0, masked = 0;
+    uint64_t splats = 0, tested = 0, nodes = 0, masked = 0, occluded = 0, occl_rays = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
     /* with visibility masks, a batch of rays at a time: masks first */
     uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
@@ -294,12 +300,12 @@ int splat_maps_splat(splat_state *s)
         uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
         if (s->mask)
             splat_mask_build(s, k0, k1 - k0);
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, masked)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, masked, occluded, occl_rays)
         for (uint32_t part = 0; part < s->tree.nparts; part++) {
             cdl_skd_count cnt = {0, 0};
             ray_ctx c;
             c.s = s;
-            c.splats = c.masked = 0;
+            c.splats = c.masked = c.occluded = c.occl_rays = 0;
             for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
                 cdl_splat_ray sr = splat_ray_of(s, r);
@@ -310,12 +316,16 @@ int splat_maps_splat(splat_state *s)
             }
             splats += c.splats;
             masked += c.masked;
+            occluded += c.occluded;
+            occl_rays += c.occl_rays;
             tested += cnt.tested;
             nodes += cnt.nodes;
         }
     }
     s->st.splats += splats;
     s->st.masked += masked;
+    s->st.occluded += occluded;
+    s->st.occl_rays += occl_rays;
     s->st.tested += tested;
     s->st.nodes += nodes;
     return 0;

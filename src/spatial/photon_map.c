@@ -106,6 +106,8 @@ static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 
                      ? cdl_kd_knn_guess(&m->kd, x, q->k, q->max_r2, q->guess, q->cap, q->idx, q->d2)
                      : cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
     *r2 = n == q->k ? q->d2[0] : q->max_r2;
+    if (q->shrink > 0.0f && q->shrink < 1.0f)
+        *r2 *= q->shrink;
     return *r2 > 0.0f ? n : 0;
 }
 
@@ -114,9 +116,22 @@ static int left_out(const cdl_pm_query *q, const cdl_photon *ph)
     return (cdl_photon_flags(ph) & q->skip) || (q->max_depth && cdl_photon_depth(ph) > q->max_depth);
 }
 
-static int visible(const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nx, const cdl_photon *ph)
+/* A query's lifted origin, made on the first photon that needs it. */
+typedef struct vis_origin {
+    cdl_vec3 x, nx, wx, o;
+    float lift;
+    int ready;
+} vis_origin;
+
+static int visible(const cdl_pm_query *q, vis_origin *vo, const cdl_photon *ph)
 {
-    return !q->vis.fn || q->vis.fn(q->vis.ctx, x, nx, cdl_v3(ph->p[0], ph->p[1], ph->p[2]), cdl_photon_n(ph));
+    if (!q->vis.fn)
+        return 1;
+    if (!vo->ready) {
+        vo->o = q->vis.origin(q->vis.ctx, vo->x, vo->nx, vo->wx, vo->lift);
+        vo->ready = 1;
+    }
+    return q->vis.fn(q->vis.ctx, vo->o, cdl_v3(ph->p[0], ph->p[1], ph->p[2]), cdl_photon_wi(ph));
 }
 
 cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 wo,
@@ -126,6 +141,7 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     cdl_vec3 nx = cdl_dot(b->ng, wo) < 0.0f ? cdl_neg(b->ng) : b->ng;
     float r2;
     uint32_t n = gather(m, q, x, &r2);
+    vis_origin vo = {x, nx, wo, x, CDL_VIS_LIFT * sqrtf(r2), 0};
     /* Lambertian: f = kd / pi wherever the BSDF reflects, which only the
      * signs of wi decide (no normalization, no general evaluation) */
     int lambert = b->type == CDL_MAT_DIFFUSE;
@@ -133,7 +149,8 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     cdl_vec3 fd = cdl_scale(b->kd, (float)CDL_INV_PI), zero = cdl_v3(0.0f, 0.0f, 0.0f);
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
-        if (left_out(q, ph))
+        float w = kernel_w(q->kernel, q->d2[i], r2);
+        if (!(w > 0.0f) || left_out(q, ph))
             continue;
         cdl_vec3 f;
         if (lambert) {
@@ -143,29 +160,37 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
         } else {
             f = cdl_bsdf_eval(b, wo, cdl_photon_wi(ph), 0);
         }
-        float w = kernel_w(q->kernel, q->d2[i], r2);
-        if (cdl_is_black(f) || !(w > 0.0f) || !visible(q, x, nx, ph))
+        if (cdl_is_black(f) || !visible(q, &vo, ph))
             continue;
         L = cdl_add(L, cdl_scale(cdl_mul(f, cdl_v3(ph->power[0], ph->power[1], ph->power[2])), w));
     }
     return n ? cdl_scale(L, 1.0f / kernel_area(q->kernel, r2)) : L;
 }
 
-cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nrm)
+static cdl_vec3 irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nrm, cdl_vec3 wx,
+                           float *r2_out)
 {
     cdl_vec3 E = cdl_v3(0.0f, 0.0f, 0.0f);
-    float r2;
+    float r2 = 0.0f;
     uint32_t n = gather(m, q, x, &r2);
+    *r2_out = r2;
+    vis_origin vo = {x, nrm, wx, x, CDL_VIS_LIFT * sqrtf(r2), 0};
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
         float w = kernel_w(q->kernel, q->d2[i], r2);
         if (!(w > 0.0f) || left_out(q, ph) ||
             cdl_dot(cdl_photon_n(ph), nrm) < -0.5f || cdl_dot(cdl_photon_wi(ph), nrm) <= 0.0f ||
-            !visible(q, x, nrm, ph))
+            !visible(q, &vo, ph))
             continue;
         E = cdl_add(E, cdl_scale(cdl_v3(ph->power[0], ph->power[1], ph->power[2]), w));
     }
     return n ? cdl_scale(E, 1.0f / kernel_area(q->kernel, r2)) : E;
+}
+
+cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 nrm)
+{
+    float r2;
+    return irradiance(m, q, x, nrm, nrm, &r2);
 }
 
 /* 1 in `every` photons carries an irradiance point, picked by a hash of its
@@ -206,6 +231,7 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
             cdl_irr_point *p = &im->pt[np++];
             memcpy(p->p, ph->p, sizeof p->p);
             p->n = cdl_oct_encode_bits(cdl_photon_n(ph), 16);
+            p->wi = cdl_oct_encode_bits(cdl_photon_wi(ph), 16);
         } else {
             rc = cdl_pmap_append(est, ph, 1, err);
         }
@@ -223,7 +249,7 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
     {
         uint32_t *idx = malloc(sizeof(uint32_t) * k);
         float *d2 = malloc(sizeof(float) * k);
-        cdl_pm_query q = {k, qt->max_r2, qt->kernel, 0, idx, d2, qt->vis, qt->max_depth, NULL, 0};
+        cdl_pm_query q = {k, qt->max_r2, qt->kernel, 0, idx, d2, qt->vis, qt->max_depth, NULL, 0, qt->shrink};
         if (!idx || !d2) {
 #pragma omp atomic write
             fail = 1;
@@ -234,9 +260,13 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
                 continue;
             cdl_irr_point *p = &im->pt[i];
             cdl_vec3 x = cdl_v3(p->p[0], p->p[1], p->p[2]), nrm = cdl_oct_decode_bits(p->n, 16);
-            cdl_vec3 E = cdl_pmap_irradiance(est, &q, x, nrm);
+            cdl_vec3 wx = cdl_oct_decode_bits(p->wi, 16);
+            float r2 = 0.0f, r2c = 0.0f;
+            cdl_vec3 E = irradiance(est, &q, x, nrm, wx, &r2);
             if (caustic->n)
-                E = cdl_add(E, cdl_pmap_irradiance(caustic, &q, x, nrm));
+                E = cdl_add(E, irradiance(caustic, &q, x, nrm, wx, &r2c));
+            /* the point stands for the larger of its two discs */
+            p->r2 = r2 > r2c ? r2 : r2c;
             p->E[0] = E.x;
             p->E[1] = E.y;
             p->E[2] = E.z;
@@ -275,13 +305,20 @@ void cdl_irr_free(cdl_irr_map *im)
     memset(im, 0, sizeof *im);
 }
 
-static int irr_usable(const cdl_irr_point *p, cdl_vec3 x, cdl_vec3 n, cdl_vis vis)
+static int irr_usable(const cdl_irr_point *p, float d2, int own_radius, cdl_vec3 x, cdl_vec3 n, cdl_vec3 wx,
+                      cdl_vis vis)
 {
     cdl_vec3 pn = cdl_oct_decode_bits(p->n, 16);
-    return cdl_dot(pn, n) > 0.9f && (!vis.fn || vis.fn(vis.ctx, x, n, cdl_v3(p->p[0], p->p[1], p->p[2]), pn));
+    if ((own_radius && !(d2 < p->r2)) || !(cdl_dot(pn, n) > 0.9f))
+        return 0;
+    if (!vis.fn)
+        return 1;
+    cdl_vec3 o = vis.origin(vis.ctx, x, n, wx, CDL_VIS_LIFT * sqrtf(d2));
+    return vis.fn(vis.ctx, o, cdl_v3(p->p[0], p->p[1], p->p[2]), cdl_oct_decode_bits(p->wi, 16));
 }
 
-cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, cdl_vis vis, int *found)
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, cdl_vec3 wx, float max_r2, int own_radius,
+                        cdl_vis vis, int *found)
 {
     uint32_t idx[8];
     float d2[8];
@@ -290,14 +327,14 @@ cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max
         return cdl_v3(0.0f, 0.0f, 0.0f);
     /* the nearest point almost always serves: one cheap 1-NN search first */
     uint32_t m = cdl_kd_knn(&im->kd, x, 1, max_r2, idx, d2), tried = m ? idx[0] : UINT32_MAX;
-    if (m && irr_usable(&im->pt[idx[0]], x, n, vis)) {
+    if (m && irr_usable(&im->pt[idx[0]], d2[0], own_radius, x, n, wx, vis)) {
         *found = 1;
         return cdl_v3(im->pt[idx[0]].E[0], im->pt[idx[0]].E[1], im->pt[idx[0]].E[2]);
     }
     m = m ? cdl_kd_knn(&im->kd, x, 8, max_r2, idx, d2) : 0;
     for (uint32_t i = 0; i < m; i++) {
         const cdl_irr_point *p = &im->pt[idx[i]];
-        if (idx[i] != tried && irr_usable(p, x, n, vis)) {
+        if (idx[i] != tried && irr_usable(p, d2[i], own_radius, x, n, wx, vis)) {
             *found = 1;
             return cdl_v3(p->E[0], p->E[1], p->E[2]);
         }

@@ -66,19 +66,41 @@ int cdl_pmap_build(cdl_photon_map *m, cdl_error *err);
 size_t cdl_pmap_bytes(const cdl_photon_map *m);
 
 /* Optional visibility test between a query point x (normal nx, on the
- * side being estimated) and a stored point p (normal np): 0 when a surface
- * lies between them. Estimates leave such photons out, so that light does
- * not leak through a wall standing on a floor that runs under it. The
- * spatial layer knows no geometry; the caller supplies the test. */
+ * side being estimated) and stored points p (normal np). Estimates leave
+ * hidden photons out, so that light does not leak through a wall standing
+ * on a floor that runs under it. A query first moves x off its surface
+ * (origin: back along wx, where the ray that found x came from, then by
+ * up to `lift` along nx, less where something is nearer), then tests the
+ * segment from there to each photon, moved back along its own arrival
+ * direction wp (fn: 1 if nothing blocks it). Both ends move along paths
+ * that light or the eye took, and the lift is tested, so a photon counts
+ * only if a free path joins it to x: none from a room that no light path
+ * can enter, even where a wall of zero thickness meets another surface.
+ * The spatial layer knows no geometry; the caller supplies the tests. */
 typedef struct cdl_vis {
-    int (*fn)(const void *ctx, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np);
+    cdl_vec3 (*origin)(const void *ctx, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 wx, float lift);
+    int (*fn)(const void *ctx, cdl_vec3 o, cdl_vec3 p, cdl_vec3 wp);
     const void *ctx;
 } cdl_vis;
+/* The lift of a query of radius r: a quarter of it, so that the segment
+ * to a photon of the same convex surface clears it (the surface falls
+ * d^2 / (2 rho) below the tangent plane at distance d, under d / 4 for
+ * d < rho / 2). */
+#define CDL_VIS_LIFT 0.25f
 
 /* A radiance query: k nearest within max_r2; photons with any of the
  * skip flags, or that vis (if set) finds hidden, are left out of the sum
  * (but still fix the radius, so the estimate is that of the remaining
- * subset). scratch must hold k. */
+ * subset). scratch must hold k.
+ *
+ * shrink (in (0, 1]) scales the squared radius the k nearest give before
+ * the estimate: only photons within sqrt(shrink) r_k count, over that
+ * smaller disc. Given r_k the k - 1 photons inside are spread as the
+ * density is, so for a locally uniform density the expectation is that
+ * of the k-NN estimate, (k - 1) / (pi r_k^2), while the kernel's blur (the
+ * bias) shrinks with the radius: progressive photon mapping's radius
+ * reduction (Knaus & Zwicker 2011) with a radius that still adapts to the
+ * photon density as Jensen's does. 1: Jensen's estimate. */
 typedef struct cdl_pm_query {
     uint32_t k;
     float max_r2;
@@ -91,6 +113,7 @@ typedef struct cdl_pm_query {
     float *guess;       /* coherent queries (pixel after pixel): the radius^2 to try first
                          * (cdl_kd_knn_guess), updated by each query; NULL: a k-NN heap */
     uint32_t cap;       /* entries idx and d2 hold (>= k) */
+    float shrink;       /* squared-radius factor in (0, 1]; 0 counts as 1 */
 } cdl_pm_query;
 
 /* Reflected radiance at x towards wo: sum of f(wo, wi_p) flux_p w(d_p)
@@ -106,7 +129,9 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
 typedef struct cdl_irr_point {
     float p[3];
     float E[3];
-    uint32_t n; /* octahedral normal, 2 x 16 bits */
+    uint32_t n;  /* octahedral normal, 2 x 16 bits */
+    float r2;    /* squared radius of the point's estimate (after shrink) */
+    uint32_t wi; /* its photon's arrival direction, octahedral 2 x 16 bits */
 } cdl_irr_point;
 
 typedef struct cdl_irr_map {
@@ -120,7 +145,8 @@ typedef struct cdl_irr_map {
 } cdl_irr_map;
 
 /* Irradiance at x on a surface with normal n from the photons of m
- * arriving from n's side (photons of surfaces facing elsewhere left out). */
+ * arriving from n's side (photons of surfaces facing elsewhere left out);
+ * visibility tests start from x moved along n. */
 cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, cdl_vec3 n);
 /* Irradiance at 1 in `every` (>= 2) global photons, estimated from the
  * other global photons (kept in im->est) and the caustic map with the
@@ -130,8 +156,12 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
 void cdl_irr_free(cdl_irr_map *im);
 /* Irradiance of the nearest point within sqrt(max_r2) whose normal is
  * within about 25 degrees of n (and that vis, if set, finds visible from
- * x); 0 if there is none among the 8 nearest (*found = 0). */
-cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, float max_r2, cdl_vis vis, int *found);
+ * x, found by a ray arriving along -wx); 0 if there is none among the 8
+ * nearest (*found = 0). With own_radius a point serves only within the
+ * radius of its own estimate: the lookup's blur then shrinks with the
+ * estimates' (progressive radius reduction). */
+cdl_vec3 cdl_irr_lookup(const cdl_irr_map *im, cdl_vec3 x, cdl_vec3 n, cdl_vec3 wx, float max_r2, int own_radius,
+                        cdl_vis vis, int *found);
 static inline size_t cdl_irr_bytes(const cdl_irr_map *im)
 {
     return (size_t)im->n * sizeof(cdl_irr_point) + cdl_kd_bytes(&im->kd) + cdl_pmap_bytes(&im->est);

@@ -96,6 +96,13 @@ typedef struct cdl_splat_ray {
     float zmin; /* least height over the origin's tangent plane of a sample
                  * facing back into it (its other side, if the origin's
                  * surface is a thin two-sided sheet): a little above 0 */
+    float otol; /* > 0: the ray's origin must lie in front of a one-sided
+                 * sample's tangent plane (or within otol behind it). A ray
+                 * in the room on the far side of a thin wall passes close
+                 * to the wall's samples on this side, which face it, and
+                 * (beyond its hit, in a concave corner) feeds them through
+                 * the wall; a ray that lands near a sample of a convex
+                 * surface starts in front of its plane unless it grazes. */
 } cdl_splat_ray;
 
 /* A feasible eye sample: its tree position, kernel times cosine (per unit
@@ -132,6 +139,8 @@ static inline float cdl_splat_weight_grad(const cdl_splat_ray *r, cdl_vec3 p, cd
     float z = cdl_dot(D, r->d);
     float zn = cdl_dot(D, r->on);
     if (!(z >= 0.0f) || zn < 0.0f || (zn < r->zmin && cdl_dot(n, r->on) < CDL_SKD_SHEET_COS))
+        return 0.0f;
+    if (r->otol > 0.0f && !(flags & CDL_SKD_TWO_SIDED) && cdl_dot(D, n) > r->otol)
         return 0.0f;
     float h = r->h0 + r->dh * (z < r->len ? z : r->len);
     float h2 = h * h;

@@ -72,11 +72,14 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
                                  _mm512_fmadd_ps(ny, _mm512_set1_ps(r->on.y), _mm512_mul_ps(nx, _mm512_set1_ps(r->on.x))));
     ok &= (__mmask16)(_mm512_cmp_ps_mask(zn, _mm512_set1_ps(r->zmin), _CMP_GE_OQ) |
                       _mm512_cmp_ps_mask(non, _mm512_set1_ps(CDL_SKD_SHEET_COS), _CMP_GE_OQ));
+    __m512 dpn = _mm512_fmadd_ps(Dz, nz, _mm512_fmadd_ps(Dy, ny, _mm512_mul_ps(Dx, nx)));
+    if (r->otol > 0.0f) /* the origin in front of a one-sided sample's plane (cdl_splat_ray.otol) */
+        ok &= (__mmask16)(_mm512_cmp_ps_mask(dpn, _mm512_set1_ps(r->otol), _CMP_LE_OQ) |
+                          _mm512_cmp_ps_mask(_mm512_loadu_ps(t->two + b), zero, _CMP_GT_OQ));
     if (plane) {
         /* reached the sample's tangent plane ((D . n) / dn <= X, without
          * the division), or ended within h of the sample (a neighbouring
          * surface of a concave corner) */
-        __m512 dpn = _mm512_fmadd_ps(Dz, nz, _mm512_fmadd_ps(Dy, ny, _mm512_mul_ps(Dx, nx)));
         __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, _mm512_set1_ps(r->len * 1.0001f));
         __m512 Xdn = _mm512_mul_ps(X, dn);
         __mmask16 neg = _mm512_cmp_ps_mask(dn, zero, _CMP_LT_OQ);
@@ -110,7 +113,7 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
-    const float zmin = r->zmin;
+    const float zmin = r->zmin, otol = r->otol > 0.0f ? r->otol : INFINITY;
     const float norm = (float)(2.0 / CDL_PI);
     const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
     const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
@@ -131,10 +134,12 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         float non = nx[i] * nx0 + ny[i] * ny0 + nz[i] * nz0;
         /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f) & ((zn >= zmin) | (non >= CDL_SKD_SHEET_COS));
+        float dpn = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
+        ok &= (dpn <= otol) | (two[i] > 0.0f); /* cdl_splat_ray.otol */
         if (plane) {
             /* the distance tp = (D . n) / dn to the sample's tangent plane
              * against X, without the division: dn < 0 flips the test */
-            float dpn = Dx * nx[i] + Dy * ny[i] + Dz * nz[i], X = len * 1.0001f + 1e-3f * h;
+            float X = len * 1.0001f + 1e-3f * h;
             int reached = ((dn < 0.0f) & (dpn >= X * dn)) | ((dn >= 0.0f) & (dpn <= X * dn));
             /* reached the sample's tangent plane, or ended within h of the
              * sample (a neighbouring surface of a concave corner) */

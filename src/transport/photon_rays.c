@@ -344,8 +344,8 @@ int cdl_pray_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_pray_para
     for (int c = 0; c < CDL_PRAY_CATS; c++) {
         open[c] = pp->target[c] > 0;
         nopen += open[c];
-        double m = (double)pp->target[c] * pp->m_scale;
-        cx.base[c] = pp->C / pow(m > 1.0 ? m : 1.0, 1.0 / 6.0);
+        double m = (double)pp->target[c];
+        cx.base[c] = pp->C / pow(m > 1.0 ? m : 1.0, 1.0 / 6.0) * (pp->bw_scale > 0.0 ? pp->bw_scale : 1.0);
     }
     uint32_t maxchunks = MAX_BATCH / CHUNK;
     ray_buf *bufs = calloc(maxchunks, sizeof *bufs);

@@ -53,7 +53,7 @@ typedef struct cdl_pray_params {
     float C, S, R;
     float d2_clamp;                  /* D~^2 */
     float w, mu;                     /* from the pilot (cdl_pray_pilot) */
-    double m_scale;                  /* the bandwidth's M is target * m_scale (passes so far) */
+    double bw_scale;                 /* every bandwidth times this (the progressive schedule); 0: 1 */
     uint64_t max_paths;
 } cdl_pray_params;
 

@@ -99,22 +99,38 @@ static void trace_path(const trace_ctx *cx, uint64_t i, int caustic_only, cdl_ve
     }
 }
 
-int cdl_photon_visible(const void *scene, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np)
+/* Two ray offsets at p (the margin every path vertex keeps). */
+static float two_offsets(const cdl_scene *s, cdl_vec3 p)
+{
+    return 2.0f * (s->eps + cdl_maxf(fabsf(p.x), cdl_maxf(fabsf(p.y), fabsf(p.z))) * 1e-5f);
+}
+
+cdl_vec3 cdl_photon_vis_origin(const void *scene, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 wx, float lift)
 {
     const cdl_scene *s = scene;
-    float len = cdl_length(cdl_sub(p, x));
-    /* Both ends lifted by a tenth of their distance on top of the usual
-     * offset: the chord between two points of one curved surface (sagitta
-     * len^2 / 8 rho) then clears it for len < 0.8 rho, while a wall standing
-     * between them still blocks. */
-    float lift = 0.1f * len;
-    cdl_vec3 a = cdl_madd(cdl_offset(s, x, nx, nx), nx, lift);
-    cdl_vec3 b = cdl_madd(cdl_offset(s, p, np, np), np, lift);
-    cdl_vec3 d = cdl_sub(b, a);
+    /* back along the ray that found x: the side of x its light reaches,
+     * even on a line where a sheet of zero thickness meets a wall */
+    cdl_vec3 a = cdl_madd(x, wx, two_offsets(s, x));
+    cdl_hit h;
+    if (!(lift > 0.0f))
+        return a;
+    /* the lift itself must not pass through anything (a thin wall just
+     * above a floor, a shelf board): half way to the first hit */
+    if (cdl_intersect(s, a, nx, lift, &h))
+        lift = 0.5f * h.t;
+    return cdl_madd(a, nx, lift);
+}
+
+int cdl_photon_visible(const void *scene, cdl_vec3 o, cdl_vec3 p, cdl_vec3 wp)
+{
+    const cdl_scene *s = scene;
+    /* back along the photon's own last segment: free space on its side */
+    cdl_vec3 b = cdl_madd(p, wp, two_offsets(s, p));
+    cdl_vec3 d = cdl_sub(b, o);
     float dl = cdl_length(d);
     if (!(dl > 0.0f))
         return 1;
-    return !cdl_occluded(s, a, cdl_scale(d, 1.0f / dl), dl * (1.0f - 1e-4f));
+    return !cdl_occluded(s, o, cdl_scale(d, 1.0f / dl), dl);
 }
 
 /* Paths [first, first + n) in chunks of CHUNK on all threads. */

@@ -42,9 +42,12 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
                       cdl_sampler_kind kind, uint64_t seed, uint32_t pass, cdl_photon_map *global,
                       cdl_photon_map *caustic, cdl_photon_stats *st, cdl_error *err);
 
-/* cdl_vis test for photon estimates: 0 if a surface blocks the segment
- * between x and p, both lifted off their surfaces (ctx: the cdl_scene). */
-int cdl_photon_visible(const void *scene, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 p, cdl_vec3 np);
+/* The cdl_vis tests of photon estimates (ctx: the cdl_scene): x moved two
+ * ray offsets back along wx, then lifted along nx by `lift` or half way
+ * to what lies nearer; 0 if a surface blocks the segment from o to p moved
+ * two ray offsets back along wp. */
+cdl_vec3 cdl_photon_vis_origin(const void *scene, cdl_vec3 x, cdl_vec3 nx, cdl_vec3 wx, float lift);
+int cdl_photon_visible(const void *scene, cdl_vec3 o, cdl_vec3 p, cdl_vec3 wp);
 
 /* The path limit when none is given: 1000 per photon, at least 2^20. */
 static inline uint64_t cdl_photons_default_max_paths(uint32_t photons)
