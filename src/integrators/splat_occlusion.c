@@ -127,8 +127,9 @@ int splat_occl_seen(const splat_state *s, const cdl_photon_ray *r, uint32_t q, f
 uint32_t splat_occl_filter(const splat_state *s, const cdl_photon_ray *r, uint32_t first, uint32_t mask,
                            const float *iz, uint64_t *rays)
 {
+    /* Embree reads the packet and its valid mask with aligned 64-byte loads */
     struct RTCRay16 p;
-    int valid[16];
+    _Alignas(64) int valid[16];
     uint32_t need = 0;
     for (uint32_t i = 0; i < 16; i++) {
         cdl_vec3 o, d;

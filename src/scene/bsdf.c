@@ -213,7 +213,7 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
                          float u2, cdl_scatter *s)
 {
     float go = cdl_dot(wo, b->ng);
-    if (go == 0.0f)
+    if (fabsf(go) < 1e-6f)
         return 0;
     cdl_vec3 lo = cdl_to_local(&b->frame, wo);
     float side = go < 0.0f ? -1.0f : 1.0f;
@@ -237,8 +237,10 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     if (li.z <= 0.0f)
         return 0;
     cdl_vec3 wi = cdl_to_world(&b->frame, cdl_v3(li.x, li.y, li.z * side));
-    /* The shading frame may send wi below the geometric surface. */
-    if (cdl_dot(wi, b->ng) * go <= 0.0f)
+    /* The shading frame may send wi below the geometric surface; grazing
+     * as opaque_local (eval and pdf) defines it */
+    float gi = cdl_dot(wi, b->ng);
+    if (gi * go <= 0.0f || fabsf(gi) < 1e-6f)
         return 0;
     float pdf;
     cdl_vec3 f = opaque_eval(b, lo, li, &pdf);
