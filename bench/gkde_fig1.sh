@@ -36,8 +36,8 @@ args=("$scene" "${cam[@]}" --res 320x240 --maxdepth 1)
 mkdir -p "$out"
 [ -f "$out/ref.exr" ] || "$candela" render "${args[@]}" -i path --spp "$refspp" -q -o "$out/ref.exr"
 "$candela" render "${args[@]}" -i gkde --progressive off --overlaps 5 --time "$budget" -o "$out/gkde.exr" | tee "$out/gkde.log"
-"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --gather 0 --direct photons --time "$budget" -o "$out/pm.exr" | tee "$out/pm.log"
-"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --gather 0 --direct photons --visibility all --time "$budget" -o "$out/pm_vis.exr" |
+"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --photons 100000 --gather 0 --direct photons --time "$budget" -o "$out/pm.exr" | tee "$out/pm.log"
+"$candela" render "${args[@]}" -i pm --progressive off --visibility gather --knn 50 --photons 100000 --gather 0 --direct photons --visibility all --time "$budget" -o "$out/pm_vis.exr" |
   tee "$out/pm_vis.log"
 "$py" - "$out" "$here/docs/gkde-fig1.png" <<'EOF'
 import sys

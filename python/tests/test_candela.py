@@ -207,7 +207,7 @@ def test_discovery():
     names = candela.integrators()
     assert set(names) >= {"path", "bdpt", "ir", "rigi", "pm", "gkde", "splat"}
     pm = {o["name"]: o for o in candela.options("pm")}
-    assert pm["photons"]["default"] == "100000" and "spp" in pm and "mode" not in pm
+    assert pm["photons"]["default"] == "200000" and "spp" in pm and "mode" not in pm
     splat = {o["name"]: o for o in candela.options("splat")}
     assert splat["photons"]["default"] == "200000"
     assert candela.version().count(".") == 2

@@ -38,7 +38,7 @@ static const cdl_option_info options[] = {
     {"shadow-rays", "KIND", "ir,rigi,gkde", "bundle", "bundle (one Embree ray stream per point light and tile, or per footprint) or single; pm: a number (below)", "Bidirectional and point-light methods (bdpt, ir, rigi)"},
     {"progressive", "on|off", "pm,gkde,splat", "on", "consistent: every bandwidth (pm's radii, gkde's h, splat's kernels) shrinks with the pass index i as r_i^2 = r_0^2 prod (j + alpha) / (j + 1) (Knaus & Zwicker 2011), so the bias falls with time; off: the fixed bandwidths of the reports", "Density estimation (pm, gkde, splat)"},
     {"alpha", "a", "pm,gkde,splat", "0.667", "radius reduction: r^2 falls about as i^(alpha - 1); in (0, 1), smaller shrinks faster with more noise", "Density estimation (pm, gkde, splat)"},
-    {"photons", "N", "pm", "100000", "global photons stored per pass; paths are traced until the map holds N", "Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)"},
+    {"photons", "N", "pm", "200000", "global photons stored per pass; paths are traced until the map holds N", "Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)"},
     {"knn", "K", "pm", "20", "photons per radiance estimate (their radius, scaled by the pass's factor with --progressive)", "Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)"},
     {"max-radius", "R", "pm", "", "largest estimate radius (default 5 % of the diagonal)", "Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)"},
     {"kernel", "KIND", "pm", "cone", "box, cone or epanechnikov", "Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)"},

@@ -27,7 +27,7 @@ void cdl_options_default(cdl_options *o)
     o->interleave = 1;
     o->progressive = 1;
     o->alpha = 2.0f / 3.0f;
-    o->pm.photons = 100000;
+    o->pm.photons = 200000;
     o->pm.k = 20;
     o->pm.kernel = 1; /* cone */
     o->pm.gather = 8;

@@ -21,20 +21,23 @@
 
 struct splat_occl {
     float *rho; /* per eye sample (tree order): its clearance; INFINITY: not tested */
+    float *up;  /* per eye sample: free distance along its normal (the lift's bound) */
     uint32_t cap;
 };
 
 void splat_occl_free(splat_state *s)
 {
-    if (s->occl)
+    if (s->occl) {
         free(s->occl->rho);
+        free(s->occl->up);
+    }
     free(s->occl);
     s->occl = NULL;
 }
 
 size_t splat_occl_bytes(const splat_state *s)
 {
-    return s->occl ? (size_t)s->occl->cap * sizeof(float) : 0;
+    return s->occl ? 2 * (size_t)s->occl->cap * sizeof(float) : 0;
 }
 
 static int cmp_float(const void *a, const void *b)
@@ -50,9 +53,12 @@ int splat_occl_prepare(splat_state *s, cdl_error *err)
     struct splat_occl *o = s->occl;
     if (o->cap < s->neye + 16) {
         float *r = realloc(o->rho, sizeof(float) * (s->neye + 16));
-        if (!r)
+        if (r)
+            o->rho = r;
+        float *u = r ? realloc(o->up, sizeof(float) * (s->neye + 16)) : NULL;
+        if (!u)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the occlusion test");
-        o->rho = r;
+        o->up = u;
         o->cap = s->neye + 16;
     }
     /* clearances out to the reach of most kernels past their hits (the
@@ -76,6 +82,12 @@ int splat_occl_prepare(splat_state *s, cdl_error *err)
         }
         cdl_vec3 x = cdl_v3(t->p[0][q], t->p[1][q], t->p[2][q]), n = cdl_v3(t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]);
         o->rho[q] = cdl_clearance(s->scene, x, n, reach);
+        /* the lift's bound: half way to what lies above the sample, from
+         * where the camera's ray found it */
+        cdl_hit h;
+        float m = cdl_maxf(fabsf(x.x), cdl_maxf(fabsf(x.y), fabsf(x.z)));
+        cdl_vec3 a = cdl_madd(x, s->eye[q].wo, 2.0f * (s->scene->eps + m * 1e-5f));
+        o->up[q] = cdl_intersect(s->scene, a, n, reach, &h) ? 0.5f * h.t : reach;
     }
     return 0;
 }
@@ -101,8 +113,16 @@ static int segment(const splat_state *s, const cdl_photon_ray *r, uint32_t q, fl
     if (cdl_dot(v, v) < rho * rho)
         return 0;
     /* back along the camera's path to the sample: its side of the surface
-     * even where a sheet of zero thickness meets a wall */
+     * even where a sheet of zero thickness meets a wall; then lifted along
+     * its normal by a quarter of the kernel's radius at c (less where
+     * something lies nearer above), as pm lifts its queries: a segment
+     * that grazes the surface is blocked by any step on it (a rug's edge,
+     * a skirting board), which left those splats out and read dark near
+     * every such step, a bias that falls only with the kernels */
     *o = cdl_madd(x, s->eye[q].wo, e);
+    float lift = cdl_minf(0.25f * (r->h0 + r->dh * z), s->occl->up[q]);
+    if (lift > 0.0f)
+        *o = cdl_madd(*o, cdl_v3(t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]), lift);
     cdl_vec3 ac = cdl_sub(c, *o);
     *len = cdl_length(ac);
     if (!(*len > 0.0f))

@@ -22,8 +22,11 @@ References: tests/data/NAME_path_160.exr where the tests have one (160x120,
 32768 spp: tests/data/make_interior_refs.sh), else rendered once into --refs
 (path, --ref-time seconds) and reused; delete them to render again.
 
-Example (T = 12 s: 16T = 192 s per method and scene, about 1.5 h in all):
-  PYTHONPATH=python bench/consistency --time 12 --out out/consistency --plots docs
+Run it through bench/consistency.sh (sets the package and library paths).
+Example (T = 12 s: 16T = 192 s per method and scene, about 75 min in all):
+  bench/consistency.sh --time 12 --out out/consistency --plots docs
+--replot CSV[,CSV...] writes the table and plots again from earlier results
+(rows of later files replace earlier ones of the same scene, method and T).
 """
 
 import argparse
@@ -44,8 +47,8 @@ SCENES = {
     "livingroom": ("livingroom.obj", "livingroom.cam", None, False),
     "livingroom_sky": ("livingroom_sky.pbrt", None, None, False),
     "livingroom_mitsuba": ("livingroom_mitsuba/livingroom.xml", None, None, False),
-    "doorajar": ("doorajar.obj", "doorajar.cam", None, False),
-    "stairwell": ("stairwell.obj", "stairwell.cam", None, False),
+    "doorajar": ("doorajar.obj", "doorajar.cam", (88, 10, 160, 120), False),
+    "stairwell": ("stairwell.obj", "stairwell.cam", (0, 0, 60, 120), False),
     "tworoom": ("tworoom.obj", "tworoom.cam", (88, 0, 160, 120), False),
     "doorslit": ("doorslit.obj", "doorslit.cam", (96, 0, 160, 120), False),
     "sealed0": ("sealed0.obj", "sealed0.cam", None, True),
@@ -82,6 +85,15 @@ def region_ratio(test, ref, reg):
     return float(test[y0:y1, x0:x1].sum() / r) if r > 0 else float("nan")
 
 
+def write_csv(path, rows):
+    keys = ["scene", "config", "factor", "seconds", "passes", "block", "relmse", "mean", "region", "max"]
+    with open(path + ".tmp", "w", newline="") as fh:
+        wr = csv.DictWriter(fh, keys)
+        wr.writeheader()
+        wr.writerows(rows)
+    os.replace(path + ".tmp", path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
@@ -98,7 +110,25 @@ def main():
     ap.add_argument("--out", default="out/consistency")
     ap.add_argument("--plots", default=None, help="directory for the plots (default OUT)")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--replot", default=None, help="CSV[,CSV...]: table and plots from earlier results.csv files")
     a = ap.parse_args()
+
+    plots = a.plots or a.out
+    for d in (a.out, plots):
+        os.makedirs(d, exist_ok=True)
+    if a.replot:
+        rows = {}
+        for f in a.replot.split(","):
+            with open(f) as fh:
+                for r in csv.DictReader(fh):
+                    for k in ("factor", "seconds", "block", "relmse", "mean", "region", "max"):
+                        r[k] = float(r[k])
+                    r["passes"] = int(r["passes"])
+                    rows[(r["scene"], r["config"], r["factor"])] = r
+        rows = list(rows.values())
+        write_csv(os.path.join(a.out, "results.csv"), rows)
+        report(rows, a, plots)
+        return
 
     import candela  # noqa: E402 (after --help works without the library)
 
@@ -106,9 +136,7 @@ def main():
     configs = [c.split("=", 1) for c in a.config] or [["pm", "-i pm"], ["gkde", "-i gkde"], ["splat", "-i splat"]]
     factors = [float(f) for f in a.factors.split(",")]
     refs = a.refs or os.path.join(a.out, "refs")
-    plots = a.plots or a.out
-    for d in (a.out, refs, plots):
-        os.makedirs(d, exist_ok=True)
+    os.makedirs(refs, exist_ok=True)
     common = dict(res=(w, h), maxdepth=a.maxdepth, quiet=True)
     rows = []
     for name in a.scenes.split(","):
@@ -148,19 +176,24 @@ def main():
                                mean=float(img.mean() / ref.mean()) if not sealed else float("nan"),
                                region=region_ratio(img, ref, reg), max=float(img.max()))
                     rows.append(row)
+                    write_csv(os.path.join(a.out, "results.csv"), rows)  # kept if the run is cut short
                     print("%-18s %-8s %5.0fT %7.1f s %5d passes  block %.4f  relmse %.3g  region %.4f  max %.3g"
                           % (name, cname, f, row["seconds"], row["passes"], row["block"], row["relmse"],
                              row["region"], row["max"]), file=sys.stderr, flush=True)
-    keys = ["scene", "config", "factor", "seconds", "passes", "block", "relmse", "mean", "region", "max"]
-    with open(os.path.join(a.out, "results.csv"), "w", newline="") as fh:
-        wr = csv.DictWriter(fh, keys)
-        wr.writeheader()
-        wr.writerows(rows)
+    report(rows, a, plots)
+
+
+def report(rows, a, plots):
+    """The table (table.md, printed) and one plot per scene."""
+    factors = sorted(set(r["factor"] for r in rows))
+    configs = list(dict.fromkeys(r["config"] for r in rows))
     lines = ["| scene | method | " + " | ".join("%gT block / relMSE" % f for f in factors) + " | falls |",
              "|---|---|" + "---|" * len(factors) + "---|"]
     for name in dict.fromkeys(r["scene"] for r in rows):
-        for cname, _ in configs:
-            rs = [r for r in rows if r["scene"] == name and r["config"] == cname]
+        for cname in configs:
+            rs = sorted((r for r in rows if r["scene"] == name and r["config"] == cname), key=lambda r: r["factor"])
+            if not rs:
+                continue
             if SCENES[name][3]:
                 cells = ["max %.3g" % r["max"] for r in rs]
                 falls = "sealed: %s" % ("0" if all(r["max"] == 0 for r in rs) else "LIGHT")
@@ -181,8 +214,10 @@ def main():
         if SCENES[name][3]:
             continue
         fig, ax = plt.subplots(1, 2, figsize=(9, 3.4))
-        for cname, _ in configs:
-            rs = [r for r in rows if r["scene"] == name and r["config"] == cname]
+        for cname in configs:
+            rs = sorted((r for r in rows if r["scene"] == name and r["config"] == cname), key=lambda r: r["factor"])
+            if not rs:
+                continue
             t = [r["seconds"] for r in rs]
             ax[0].loglog(t, [max(abs(1 - r["block"]), 1e-4) for r in rs], "o-", label=cname)
             ax[1].loglog(t, [r["relmse"] for r in rs], "o-", label=cname)
