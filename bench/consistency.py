@@ -187,7 +187,7 @@ def report(rows, a, plots):
     """The table (table.md, printed) and one plot per scene."""
     factors = sorted(set(r["factor"] for r in rows))
     configs = list(dict.fromkeys(r["config"] for r in rows))
-    lines = ["| scene | method | " + " | ".join("%gT block / relMSE" % f for f in factors) + " | falls |",
+    lines = ["| scene | method | " + " | ".join("%gT block / relMSE" % f for f in factors) + " | each step |",
              "|---|---|" + "---|" * len(factors) + "---|"]
     for name in dict.fromkeys(r["scene"] for r in rows):
         for cname in configs:
@@ -200,8 +200,16 @@ def report(rows, a, plots):
             else:
                 cells = ["%.4f / %.3g" % (r["block"], r["relmse"]) for r in rs]
                 b = [abs(1 - r["block"]) for r in rs]
-                falls = "bias %s, relMSE %s" % ("falls" if b[-1] < b[0] or b[0] < 0.01 else "STUCK",
-                                                  "falls" if rs[-1]["relmse"] < rs[0]["relmse"] else "STUCK")
+                # issue 25's rule, snapshot to snapshot: off by more than 1 % -> closer to 1;
+                # relMSE lower
+                steps = []
+                for p, q in zip(rs, rs[1:]):
+                    bp, bq = abs(1 - p["block"]), abs(1 - q["block"])
+                    ok_b = bq < bp or bp < 0.01
+                    ok_r = q["relmse"] < p["relmse"]
+                    steps.append("%gT: %s" % (q["factor"], "ok" if ok_b and ok_r else
+                                              "bias " + ("ok" if ok_b else "UP") + ", relMSE " + ("ok" if ok_r else "UP")))
+                falls = "; ".join(steps)
             lines.append("| %s | %s | %s | %s |" % (name, cname, " | ".join(cells), falls))
     table = "\n".join(lines) + "\n"
     with open(os.path.join(a.out, "table.md"), "w") as fh:
