@@ -12,7 +12,7 @@
 #include "core/log.h"
 #include "core/rng.h"
 #include "core/sampling.h"
-#include "scene/loader.h"
+#include "io/loader.h"
 
 static cdl_vec3 random_surface_point(const cdl_scene *s, cdl_rng *r, cdl_vec3 *n)
 {

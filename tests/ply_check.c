@@ -4,7 +4,7 @@
  * Success: the counts on stdout, exit 0. */
 #include <stdio.h>
 
-#include "scene/ply.h"
+#include "io/ply.h"
 
 int main(int argc, char **argv)
 {

@@ -92,17 +92,35 @@ int main(int argc, char **argv)
           "flag on/off: %s", err.msg);
     CHECK(cdl_settings_set(s, "importance", "maybe", &err) == CDL_ERR_USAGE, "flag 'maybe' accepted");
     CHECK(!cdl_settings_set(s, "spp", "4", &err) && !cdl_settings_set(s, "time", "1", &err) &&
-              cdl_settings_check(s, &err) == CDL_ERR_USAGE && strstr(err.msg, "either --spp or --time"),
+              cdl_settings_check(s, &err) == CDL_ERR_USAGE && strstr(err.msg, "either spp or time"),
           "spp and time together pass the check");
     cdl_settings_release(s);
     cdl_settings_release(NULL);
+
+    /* a parameter the method does not read is refused: when set once the
+     * method is known, else by the check */
+    s = cdl_settings_create();
+    CHECK(!cdl_settings_set(s, "knn", "50", &err) && !cdl_settings_check(s, &err), "knn before the method: %s",
+          err.msg);
+    CHECK(!cdl_settings_set(s, "integrator", "path", &err) && cdl_settings_check(s, &err) == CDL_ERR_USAGE &&
+              !strcmp(err.file, "knn") && strstr(err.msg, "path"),
+          "path with knn passes the check: %s %s", err.file, err.msg);
+    cdl_settings_release(s);
+    s = cdl_settings_create();
+    CHECK(!cdl_settings_set(s, "integrator", "splat", &err) && cdl_settings_set(s, "knn", "5", &err) == CDL_ERR_USAGE &&
+              !strcmp(err.file, "knn") && strstr(err.msg, "splat"),
+          "splat took knn: %s", err.msg);
+    CHECK(!cdl_settings_set(s, "gather", "2", &err) && !cdl_settings_set(s, "direct", "sample", &err) &&
+              cdl_settings_set(s, "direct", "lcon", &err) == CDL_ERR_USAGE,
+          "splat's own gather and direct: %s", err.msg);
+    cdl_settings_release(s);
 
     /* discovery */
     int found = 0;
     for (int i = 0; i < cdl_option_count(); i++) {
         const cdl_option_info *o = cdl_option_get(i);
         CHECK(o->name[0] && o->help[0] && o->section[0], "option %d incomplete", i);
-        found += !strcmp(o->name, "photons") && !strcmp(o->integrators, "pm") && !strcmp(o->default_value, "200000");
+        found += !strcmp(o->name, "photons") && !strcmp(o->integrators, "pm,splat") && !strcmp(o->default_value, "200000");
     }
     CHECK(found == 1 && !cdl_option_get(-1) && !cdl_option_get(cdl_option_count()), "option table");
     CHECK(cdl_integrator_count() == 7 && !strcmp(cdl_integrator_name(0), "path") && !cdl_integrator_name(7),

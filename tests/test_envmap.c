@@ -14,7 +14,7 @@
 #include "core/sampling.h"
 #include "film/image.h"
 #include "scene/envmap.h"
-#include "scene/loader.h"
+#include "io/loader.h"
 #include "test_util.h"
 
 static double tol_scale = 1.0;
@@ -30,7 +30,7 @@ static const char *method(const char *integ)
 static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
 {
     if (!strcmp(integ, "pm")) {
-        opt->pm.photons = 5000;
+        opt->photons = 5000;
         spp /= 16;
     }
     if (!strcmp(integ, "rigi") || !strcmp(integ, "ir")) {
@@ -38,11 +38,11 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
         spp /= 4;
     }
     if (!strcmp(integ, "gkde")) { /* a step traces its light paths and links every eye vertex */
-        opt->light_paths = 2000;
+        opt->gkde.light_paths = 2000;
         spp /= 4;
     }
     if (!strcmp(integ, "splat")) { /* a pass traces and splats its photon rays */
-        opt->splat.photons = 5000;
+        opt->photons = 5000;
         spp /= 4;
     }
     if (!strcmp(integ, "bdpt-shared")) { /* shared light paths in 2 x 2 sets */

@@ -18,7 +18,7 @@
 #include "core/log.h"
 #include "core/transform.h"
 #include "film/image.h"
-#include "scene/loader.h"
+#include "io/loader.h"
 #include "test_util.h"
 
 #define PI 3.14159265358979323846

@@ -15,8 +15,8 @@
 #include <unistd.h>
 
 #include "core/log.h"
-#include "scene/loader.h"
-#include "scene/pbrt_loader.h"
+#include "io/loader.h"
+#include "io/pbrt_loader.h"
 #include "test_util.h"
 
 static char dir[200];

@@ -14,7 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "scene/ply.h"
+#include "io/ply.h"
 #include "test_util.h"
 
 /* ---- a growable byte buffer and PLY writers ------------------------------------------------- */

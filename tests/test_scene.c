@@ -6,7 +6,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "scene/camera.h"
-#include "scene/loader.h"
+#include "io/loader.h"
 #include "test_util.h"
 
 int main(int argc, char **argv)

@@ -13,7 +13,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
-#include "scene/serialized.h"
+#include "io/serialized.h"
 #include "test_util.h"
 
 /* ---- a growable byte buffer ----------------------------------------------------------------- */

@@ -86,7 +86,7 @@ static void setup(cdl_options *opt)
            &err);
     opt->splat.fractions[0] = 1.0f;
     opt->splat.fractions[1] = opt->splat.fractions[2] = 0.0f;
-    opt->splat.photons = 100000;
+    opt->photons = 100000;
     opt->splat.C = 0.5f;
 }
 

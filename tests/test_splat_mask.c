@@ -60,7 +60,7 @@ static void setup(cdl_options *opt, cdl_vec3 eye, cdl_vec3 at)
     die_on(cdl_camera_init(&opt->camera, eye, at, cdl_v3(0, 1, 0), 40.0f, W, H, &err), &err);
     opt->splat.fractions[0] = 1.0f;
     opt->splat.fractions[1] = opt->splat.fractions[2] = 0.0f;
-    opt->splat.photons = 50000;
+    opt->photons = 50000;
     /* the report's kernels, without candela's occlusion test: the mask's own effect */
     opt->splat.C = 1.0f;
     opt->splat.occlusion = 0;

@@ -76,15 +76,18 @@ typedef void (*cdl_message_fn)(void *user, const char *file, int line, const cha
 
 /* ---- settings: every option of `candela render`, by name -------------- */
 
-/* Options are set by name and string value, named as on the command line
- * without the dashes ("spp", "res", "lookat", "photons", "max-radius"; "_"
- * may stand for "-", and leading dashes are allowed: "--spp" and "-C" work
- * too). Values are written as on the command line ("512x256", "0,1,4,0,1,0,
- * 0,1,0"); flags (e.g. "importance") take "on"/"off" (or "1"/"0", "true"/
- * "false", or NULL for on). Each value is checked when set. Repeatable
- * options ("point-light") add one entry per call. Unset options take their
- * default, or what the scene file says (camera, resolution, spp, max depth,
- * integrator). cdl_option_* below lists them all. */
+/* Parameters are set by name and string value. Names are the library's
+ * ("spp", "res", "lookat", "photons", "max_radius"; "-" may stand for "_"
+ * and leading dashes are dropped, so the command line's "--max-radius" and
+ * "-C" work too). Values are written as on the command line ("512x256",
+ * "0,1,4,0,1,0,0,1,0", "2/3"); switches (e.g. "importance") take "on"/"off"
+ * (or "1"/"0", "true"/"false", or NULL for on). Each value is checked when
+ * set; a parameter the chosen method does not read is a usage error (when
+ * set once the integrator is, else from cdl_settings_check or when the
+ * renderer is created). Repeatable ones ("point_light", "aov") add one
+ * entry per call. Unset parameters take their default, or what the scene
+ * file says (camera, resolution, spp, max depth, integrator).
+ * cdl_option_* below lists them all with their types and ranges. */
 typedef struct cdl_settings cdl_settings;
 
 CDL_API cdl_settings *cdl_settings_create(void); /* NULL when out of memory */
@@ -97,17 +100,25 @@ CDL_API int cdl_settings_check(const cdl_settings *s, cdl_error *err);
 CDL_API void cdl_settings_set_message_fn(cdl_settings *s, cdl_message_fn fn, void *user);
 
 typedef struct cdl_option_info {
-    const char *name;          /* "photons" (the command line's --photons) */
-    const char *value;         /* what it takes: "N", "WxH", "KIND", "" for a flag */
-    const char *integrators;   /* "pm", "bdpt,ir,rigi", ...; "" for every method */
-    const char *default_value; /* as text; "" when it depends on the scene */
+    const char *name;          /* "max_radius" (the command line's --max-radius) */
+    const char *value;         /* what it takes: "N", "WxH", "KIND", "" for a bare switch */
+    const char *integrators;   /* the methods that read it: "pm", "bdpt,ir,rigi", ...; "" for every method */
+    const char *default_value; /* as text; "" when the method derives it (the help says how) */
     const char *help;          /* one line, unwrapped */
     const char *section;       /* the --help section it is listed in */
+    const char *type;          /* "int", "float", "switch", "choice", "floats", "res" or "name" */
+    double min, max;           /* int, float, floats: the range (each value's) */
+    int min_open, max_open;    /* the range excludes min or max */
+    const char *choices;       /* choice: "box|cone|epanechnikov"; int: a word also taken ("sample"); else "" */
+    const char *unit;          /* "s", "deg", "MiB" or "" */
+    int repeatable;            /* each setting adds one (point_light, aov) */
 } cdl_option_info;
 
 CDL_API int cdl_option_count(void);
-/* NULL unless 0 <= i < cdl_option_count(). An option shared by methods with
- * different defaults ("photons" in pm and splat) has one entry per method. */
+/* NULL unless 0 <= i < cdl_option_count(). The common parameters first,
+ * then each method's tables in turn; a row several methods read (photons:
+ * pm and splat) is listed once, a name two methods define apart (gather:
+ * pm's and splat's) once per definition. */
 CDL_API const cdl_option_info *cdl_option_get(int i);
 
 CDL_API int cdl_integrator_count(void);

@@ -7,9 +7,11 @@
     ref = candela.read("reference.exr")
     print(candela.diff(img, ref)["relmse"])
 
-Options are named as on the command line (`candela render --help`), with
-"_" for "-": res=(w, h), lookat=(9 numbers), fov=, seed=, maxdepth=, threads=,
-photons=, max_radius=, importance=True, C=0.6, ... `options()` lists them.
+Options are the library's parameters (`candela render --help` spells them
+with "-" for "_"): res=(w, h), lookat=(9 numbers), fov=, seed=, maxdepth=,
+threads=, photons=, max_radius=, importance=True, C=0.6, ... `options()`
+lists them with types, defaults and ranges, `options("pm")` pm's; one the
+method does not read raises UsageError.
 Images are NumPy float32 arrays of shape (height, width, 3), linear RGB.
 Errors raise candela.Error (UsageError for options and calls, InputError
 for files) carrying .file, .line and .message. The GIL is released while
@@ -70,14 +72,20 @@ def integrators():
 
 
 def options(integrator=None):
-    """The options as dicts (name, value, integrators, default, help, section);
-    with integrator, those that apply to it (the general ones included)."""
+    """The parameters as dicts: name, value (what it takes), integrators (the
+    methods that read it, "" for all), default, help, section, type ("int",
+    "float", "switch", "choice", "floats", "res", "name"), min, max, min_open,
+    max_open, choices (list), unit, repeatable; with integrator, the ones it
+    reads (the common ones included)."""
     out = []
     for i in range(lib.cdl_option_count()):
         o = lib.cdl_option_get(i).contents
         d = {k: getattr(o, f).decode() for k, f in (("name", "name"), ("value", "value"),
                                                     ("integrators", "integrators"), ("default", "default_value"),
-                                                    ("help", "help"), ("section", "section"))}
+                                                    ("help", "help"), ("section", "section"), ("type", "type"),
+                                                    ("unit", "unit"))}
+        d.update(min=o.min, max=o.max, min_open=bool(o.min_open), max_open=bool(o.max_open),
+                 choices=[c for c in o.choices.decode().split("|") if c], repeatable=bool(o.repeatable))
         if integrator is None or not d["integrators"] or integrator in d["integrators"].split(","):
             out.append(d)
     return out
@@ -101,16 +109,16 @@ def _argv_pairs(argv):
     pairs, i = [], 0
     while i < len(argv):
         word = str(argv[i])
-        name = {"i": "integrator", "q": "quiet"}.get(word.lstrip("-"), word.lstrip("-"))
+        name = {"i": "integrator", "q": "quiet"}.get(word.lstrip("-"), word.lstrip("-").replace("-", "_"))
         if not word.startswith("-") or name not in kinds:
             raise UsageError(2, word, 0, "unknown option (see candela render --help)")
         if kinds[name]:
             if i + 1 >= len(argv):
                 raise UsageError(2, word, 0, "expects a value")
-            pairs.append((word, str(argv[i + 1])))
+            pairs.append((name, str(argv[i + 1])))
             i += 2
         else:
-            pairs.append((word, None))
+            pairs.append((name, None))
             i += 1
     return pairs
 
@@ -128,11 +136,15 @@ class _Settings:
                     continue
                 if key == "res" and isinstance(value, (tuple, list)):
                     if len(value) != 2:
-                        raise UsageError(2, "--res", 0, f"expected (width, height), got {value!r}")
+                        raise UsageError(2, "res", 0, f"expected (width, height), got {value!r}")
                     value = f"{value[0]}x{value[1]}"
                 if key == "point_light" and value and isinstance(value[0], (tuple, list)):
                     for light in value:  # several lights
-                        _call(lib.cdl_settings_set, self.h, b"point-light", _text(light).encode())
+                        _call(lib.cdl_settings_set, self.h, b"point_light", _text(light).encode())
+                    continue
+                if key == "aov" and isinstance(value, (tuple, list)):
+                    for layer in value:
+                        _call(lib.cdl_settings_set, self.h, b"aov", str(layer).encode())
                     continue
                 flag = isinstance(value, bool)
                 _call(lib.cdl_settings_set, self.h, key.encode(), None if flag and value else _text(value).encode())

@@ -14,7 +14,9 @@ class Error(ctypes.Structure):
 
 class OptionInfo(ctypes.Structure):
     _fields_ = [("name", c_char_p), ("value", c_char_p), ("integrators", c_char_p),
-                ("default_value", c_char_p), ("help", c_char_p), ("section", c_char_p)]
+                ("default_value", c_char_p), ("help", c_char_p), ("section", c_char_p), ("type", c_char_p),
+                ("min", c_double), ("max", c_double), ("min_open", c_int), ("max_open", c_int),
+                ("choices", c_char_p), ("unit", c_char_p), ("repeatable", c_int)]
 
 
 class SceneInfo(ctypes.Structure):

@@ -1,4 +1,4 @@
-/* The stored photons (and, with --importance, the importons) seen from
+/* The stored photons (and, with importance, the importons) seen from
  * above, as in Keller & Wald's Figures 1, 2 and 4 (`candela photons`).
  * Pass 0's maps are traced exactly as pm's first pass traces them; walls
  * (faces parallel to the up axis) are drawn grey so that rooms without
@@ -98,16 +98,25 @@ int cdl_photon_plot(cdl_scene *scene, const cdl_settings *settings, int size, cd
         summary[0] = 0;
     if (size < 16 || size > 16384)
         return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "plot size %d out of range [16, 16384]", size);
-    cdl_settings *defaults = settings ? NULL : cdl_settings_create();
-    if (!settings && !defaults)
+    /* pm's photons, whatever method the settings name */
+    cdl_settings *pm = cdl_settings_create(), *set = malloc(sizeof *set);
+    if (!pm || !set) {
+        cdl_settings_release(pm);
+        free(set);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");
-    cdl_settings set;
+    }
+    if (settings)
+        *pm = *settings;
     cdl_options opt;
-    int rc = cdl_settings_resolve(settings ? settings : defaults, scene, &set, &opt, err);
-    cdl_settings_release(defaults);
-    if (rc)
+    int rc = cdl_settings_set(pm, "integrator", "pm", err);
+    if (!rc)
+        rc = cdl_settings_resolve(pm, scene, set, &opt, err);
+    cdl_settings_release(pm);
+    if (rc) {
+        free(set);
         return rc;
-    const cdl_log_sink *prev = cdl_log_push(&set.sink);
+    }
+    const cdl_log_sink *prev = cdl_log_push(&set->sink);
     cdl_importance imp;
     cdl_photon_map g, c;
     cdl_pmap_init(&g);
@@ -165,5 +174,6 @@ int cdl_photon_plot(cdl_scene *scene, const cdl_settings *settings, int size, cd
     if (has_imp)
         cdl_importance_free(&imp);
     cdl_log_pop(prev);
+    free(set);
     return rc;
 }

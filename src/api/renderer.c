@@ -37,14 +37,14 @@ void cdl_renderer_release(cdl_renderer *r)
 
 static int add_aovs(cdl_renderer *r, cdl_error *err)
 {
-    const cdl_settings *a = &r->set;
-    if (a->aov_pathlength && cdl_film_add_aov(&r->film, "pathlength", 1, err) < 0)
+    uint32_t aov = r->opt.aov;
+    if ((aov & CDL_AOV_PATHLENGTH) && cdl_film_add_aov(&r->film, "pathlength", 1, err) < 0)
         return err ? err->code : CDL_ERR_USAGE;
-    if (a->aov_records && cdl_film_add_aov(&r->film, "records", 3, err) < 0)
+    if ((aov & CDL_AOV_RECORDS) && cdl_film_add_aov(&r->film, "records", 3, err) < 0)
         return err ? err->code : CDL_ERR_USAGE;
-    if (a->aov_bandwidth && cdl_film_add_aov(&r->film, "bandwidth", 3, err) < 0)
+    if ((aov & CDL_AOV_BANDWIDTH) && cdl_film_add_aov(&r->film, "bandwidth", 3, err) < 0)
         return err ? err->code : CDL_ERR_USAGE;
-    for (int k = 1; a->aov_strata && k <= CDL_STRATA; k++) {
+    for (int k = 1; (aov & CDL_AOV_STRATA) && k <= CDL_STRATA; k++) {
         char nm[32];
         snprintf(nm, sizeof nm, "strata%d", k);
         if (cdl_film_add_aov(&r->film, nm, 3, err) < 0)
@@ -75,9 +75,9 @@ int cdl_renderer_create(cdl_scene *scene, const cdl_settings *settings, cdl_rend
     int rc = cdl_settings_resolve(in, scene, &r->set, &r->opt, err);
     cdl_settings_release(defaults);
     if (!rc)
-        rc = cdl_integrator_create(r->set.integrator, &r->integ, err);
+        rc = cdl_integrator_create(r->set.c.integrator, &r->integ, err);
     if (!rc)
-        rc = cdl_film_init(&r->film, r->set.width, r->set.height, err);
+        rc = cdl_film_init(&r->film, r->set.c.res[0], r->set.c.res[1], err);
     if (!rc)
         rc = add_aovs(r, err);
     r->film.cancel = &r->cancel;
@@ -141,8 +141,8 @@ static int run(cdl_renderer *r, uint32_t target, double seconds, cdl_progress_fn
 {
     const cdl_log_sink *prev = cdl_log_push(&r->set.sink);
     int threads = omp_get_max_threads();
-    if (r->set.threads > 0)
-        omp_set_num_threads((int)r->set.threads);
+    if (r->set.c.threads > 0)
+        omp_set_num_threads((int)r->set.c.threads);
     r->threads = omp_get_max_threads();
     atomic_store(&r->cancel, 0);
     r->cancelled = 0;
@@ -188,9 +188,9 @@ int cdl_renderer_render(cdl_renderer *r, cdl_progress_fn progress, void *user, c
 {
     if (!r)
         return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_render: no renderer");
-    if (r->set.spp > 0)
-        return run(r, (uint32_t)r->set.spp, 0.0, progress, user, err);
-    return run(r, 0, r->set.time, progress, user, err);
+    if (r->set.c.spp > 0)
+        return run(r, (uint32_t)r->set.c.spp, 0.0, progress, user, err);
+    return run(r, 0, r->set.c.time, progress, user, err);
 }
 
 int cdl_renderer_render_passes(cdl_renderer *r, uint32_t n, cdl_progress_fn progress, void *user, cdl_error *err)
@@ -253,8 +253,8 @@ int cdl_renderer_adapt_size(cdl_renderer *r, size_t *n, cdl_error *err)
         return 0;
     const cdl_log_sink *prev = cdl_log_push(&r->set.sink);
     int threads = omp_get_max_threads();
-    if (r->set.threads > 0)
-        omp_set_num_threads((int)r->set.threads);
+    if (r->set.c.threads > 0)
+        omp_set_num_threads((int)r->set.c.threads);
     int rc = prepare(r, err); /* the state is the method's: it must exist */
     omp_set_num_threads(threads);
     cdl_log_pop(prev);
@@ -300,8 +300,8 @@ int cdl_renderer_cancelled(const cdl_renderer *r)
 
 void cdl_renderer_budget(const cdl_renderer *r, uint32_t *spp, double *seconds)
 {
-    *spp = r && r->set.spp > 0 ? (uint32_t)r->set.spp : 0;
-    *seconds = r && r->set.spp <= 0 ? r->set.time : 0.0;
+    *spp = r && r->set.c.spp > 0 ? (uint32_t)r->set.c.spp : 0;
+    *seconds = r && r->set.c.spp <= 0 ? r->set.c.time : 0.0;
 }
 
 uint32_t cdl_renderer_passes(const cdl_renderer *r)
@@ -311,17 +311,17 @@ uint32_t cdl_renderer_passes(const cdl_renderer *r)
 
 int cdl_renderer_width(const cdl_renderer *r)
 {
-    return r ? r->set.width : 0;
+    return r ? r->set.c.res[0] : 0;
 }
 
 int cdl_renderer_height(const cdl_renderer *r)
 {
-    return r ? r->set.height : 0;
+    return r ? r->set.c.res[1] : 0;
 }
 
 const char *cdl_renderer_integrator(const cdl_renderer *r)
 {
-    return r ? r->set.integrator : "";
+    return r ? r->set.c.integrator : "";
 }
 
 int cdl_renderer_layer_count(const cdl_renderer *r)
@@ -409,9 +409,9 @@ int cdl_renderer_write(const cdl_renderer *r, const char *path, const char *comm
         return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_renderer_write: no renderer or no path");
     char s_spp[32], s_seed[32], s_time[32];
     snprintf(s_spp, sizeof s_spp, "%u", r->passes);
-    snprintf(s_seed, sizeof s_seed, "%llu", r->set.seed);
+    snprintf(s_seed, sizeof s_seed, "%ld", r->set.c.seed);
     snprintf(s_time, sizeof s_time, "%.3f", r->seconds);
-    cdl_kv meta[] = {{"integrator", r->set.integrator}, {"spp", s_spp}, {"seed", s_seed},
+    cdl_kv meta[] = {{"integrator", r->set.c.integrator}, {"spp", s_spp}, {"seed", s_seed},
                      {"renderTime", s_time}, {"commandLine", command_line}};
     int nmeta = command_line ? 5 : 4;
     cdl_image img = {0}, aov[CDL_MAX_AOVS];
@@ -424,7 +424,7 @@ int cdl_renderer_write(const cdl_renderer *r, const char *path, const char *comm
         layers[i] = (cdl_layer){r->film.aovs[i].name, &aov[i], r->film.aovs[i].channels == 1};
         nl = i + 1;
     }
-    float exposure = (float)r->set.exposure;
+    float exposure = (float)r->set.c.exposure;
     if (!rc)
         rc = nl && cdl_image_has_ext(path, ".exr") ? cdl_image_write_layers(path, &img, layers, nl, meta, nmeta, err)
                                                    : cdl_image_write(path, &img, meta, nmeta, exposure, err);

@@ -4,21 +4,50 @@
 #include <string.h>
 
 #include "api/resolve.h"
+#include "core/log.h"
 #include "transport/light_select.h"
 
 /* Scene-file settings fill in what the settings left open. */
 static void apply_file(cdl_settings *a, const cdl_scene_settings *set)
 {
-    if (!a->has_integrator && set->integrator[0] && cdl_integrator_find(set->integrator))
-        memcpy(a->integrator, set->integrator, sizeof a->integrator);
-    if (!a->has_res && set->width > 0 && set->height > 0) {
-        a->width = set->width;
-        a->height = set->height;
+    cdl_common_params *c = &a->c;
+    if (!cdl_settings_given(a, "integrator") && set->integrator[0]) {
+        if (cdl_integrator_find(set->integrator))
+            memcpy(c->integrator, set->integrator, sizeof c->integrator);
+        else
+            cdl_warn(set->integrator_file, set->integrator_line, "integrator \"%s\" is not one of candela's: %s is used",
+                     set->integrator, c->integrator);
     }
-    if (!a->has_maxdepth && set->maxdepth >= 0)
-        a->maxdepth = set->maxdepth > 1024 ? 1024 : set->maxdepth;
-    if (!a->spp && a->time <= 0.0)
-        a->spp = set->spp > 0 ? set->spp : 64;
+    if (!cdl_settings_given(a, "res") && set->width > 0 && set->height > 0) {
+        c->res[0] = set->width;
+        c->res[1] = set->height;
+    }
+    if (!cdl_settings_given(a, "maxdepth") && set->maxdepth >= 0)
+        c->maxdepth = set->maxdepth > 1024 ? 1024 : set->maxdepth;
+    if (cdl_settings_given(a, "time"))
+        c->spp = 0;
+    else if (!cdl_settings_given(a, "spp") && set->spp > 0)
+        c->spp = set->spp;
+}
+
+/* The file's integrator parameters that the method reads and the settings
+ * leave open; a warning with file and line for the others. */
+static void apply_file_params(const cdl_settings *a, const cdl_scene_settings *set, const cdl_integrator_vtbl *vt,
+                              cdl_options *opt)
+{
+    for (int i = 0; i < set->nparams; i++) {
+        const cdl_scene_param *fp = &set->params[i];
+        const cdl_param *p = cdl_method_param(vt, fp->name);
+        int given = 0;
+        for (int k = 0; k < a->nmethod; k++)
+            given |= !strcmp(a->method[k].name, fp->name);
+        cdl_error e;
+        if (!p)
+            cdl_warn(fp->file, fp->line, "integrator parameter \"%s\": %s does not read it (ignored)", fp->name,
+                     vt->name);
+        else if (!given && cdl_param_set(p, fp->value, opt, &e))
+            cdl_warn(fp->file, fp->line, "integrator parameter \"%s\": %s (ignored)", fp->name, e.msg);
+    }
 }
 
 /* Default camera: looks down -z at the bounds' centre from far enough
@@ -42,35 +71,21 @@ int cdl_settings_resolve(const cdl_settings *in, const cdl_scene *scene, cdl_set
     const cdl_scene_settings *set = &scene->settings;
     apply_file(a, set);
     cdl_options_default(opt);
-    opt->maxdepth = (int)a->maxdepth;
-    opt->seed = a->seed;
-    opt->sampler = a->sampler;
-    opt->mis = a->mis;
-    opt->light_paths = a->light_paths < 0 ? CDL_LIGHT_PATHS_PER_SAMPLE : (uint32_t)a->light_paths;
-    opt->interleave = (uint32_t)a->interleave;
-    opt->threshold = (float)a->threshold;
-    opt->clamp = (float)a->clamp;
-    opt->strata_distance = a->strata_distance;
-    opt->single_shadow_rays = a->single_shadow_rays;
-    opt->progressive = a->progressive;
-    opt->alpha = (float)a->alpha;
-    opt->pm = a->pm;
-    opt->gkde = a->gkde;
-    opt->splat = a->splat;
-    if (a->photons_given)
-        opt->splat.photons = a->pm.photons;
-    if (a->gather_given)
-        opt->splat.gather = a->pm.gather;
-    if (a->direct_given)
-        opt->splat.direct_sample = !a->pm.direct_photons && a->pm.direct != CDL_DIRECT_NONE;
-    opt->splat.direct_none = a->direct_given && a->pm.direct == CDL_DIRECT_NONE;
-    if (a->has_lookat)
-        return cdl_camera_init(&opt->camera, cdl_v3(a->lookat[0], a->lookat[1], a->lookat[2]),
-                               cdl_v3(a->lookat[3], a->lookat[4], a->lookat[5]),
-                               cdl_v3(a->lookat[6], a->lookat[7], a->lookat[8]), (float)a->fov, a->width,
-                               a->height, err);
+    const cdl_common_params *c = &a->c;
+    opt->maxdepth = (int)c->maxdepth;
+    opt->seed = (uint64_t)c->seed;
+    opt->sampler = (cdl_sampler_kind)c->sampler;
+    const cdl_integrator_vtbl *vt = cdl_integrator_find(c->integrator);
+    apply_file_params(a, set, vt, opt);
+    if ((rc = cdl_settings_apply(a, vt, opt, err)))
+        return rc;
+    int w = c->res[0], h = c->res[1];
+    const float *la = c->lookat;
+    if (cdl_settings_given(a, "lookat"))
+        return cdl_camera_init(&opt->camera, cdl_v3(la[0], la[1], la[2]), cdl_v3(la[3], la[4], la[5]),
+                               cdl_v3(la[6], la[7], la[8]), (float)c->fov, w, h, err);
     if (set->has_camera)
         return cdl_camera_init_frame(&opt->camera, set->eye, set->right, set->up, set->fwd,
-                                     a->has_fov ? (float)a->fov : set->fov, a->width, a->height, err);
-    return frame_scene(scene, a->fov, a->width, a->height, &opt->camera, err);
+                                     cdl_settings_given(a, "fov") ? (float)c->fov : set->fov, w, h, err);
+    return frame_scene(scene, c->fov, w, h, &opt->camera, err);
 }

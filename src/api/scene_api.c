@@ -3,7 +3,7 @@
 #include <stdlib.h>
 
 #include "api/settings.h"
-#include "scene/loader.h"
+#include "io/loader.h"
 
 int cdl_scene_open(const char *path, const cdl_settings *settings, cdl_scene **out, cdl_error *err)
 {
@@ -19,8 +19,8 @@ int cdl_scene_open(const char *path, const cdl_settings *settings, cdl_scene **o
     int rc = cdl_scene_init(s, path, err);
     if (!rc)
         rc = cdl_scene_load(s, path, &s->settings, err);
-    for (int i = 0; !rc && settings && i < settings->nlights; i++) {
-        const float *l = settings->lights[i];
+    for (int i = 0; !rc && settings && i < settings->c.nlights; i++) {
+        const float *l = settings->c.lights[i];
         rc = cdl_scene_add_point_light(s, cdl_v3(l[0], l[1], l[2]), cdl_v3(l[3], l[4], l[5]), err);
     }
     if (!rc)

@@ -39,17 +39,59 @@ static int check_output(const char *path, cdl_error *err)
     return 0;
 }
 
-/* The table entry of option o ("--photons", "-C", "-i"), or NULL. */
-static const cdl_option_info *find(const char *o)
+/* The library's name of command-line option o ("--max-radius" ->
+ * "max_radius", "-C" -> "C", "-i" -> "integrator"), or NULL if o is not
+ * spelt as an option. */
+static const char *option_name(const char *o, char *buf, size_t n)
 {
-    while (*o == '-')
-        o++;
-    if (!strcmp(o, "i"))
-        o = "integrator";
-    for (int i = 0; i < cdl_option_count(); i++)
-        if (!strcmp(cdl_option_get(i)->name, o))
-            return cdl_option_get(i);
+    if (!strcmp(o, "-i"))
+        return "integrator";
+    if (!strcmp(o, "-q"))
+        return "quiet";
+    int single = o[0] == '-' && o[1] && !o[2]; /* -C, -S, -R */
+    if (!single && strncmp(o, "--", 2))
+        return NULL;
+    snprintf(buf, n, "%s", o + (single ? 1 : 2));
+    for (char *p = buf; *p; p++) {
+        if (*p == '_') /* the command line spells names with '-' only */
+            return NULL;
+        if (*p == '-')
+            *p = '_';
+    }
+    return buf;
+}
+
+/* The option's spelling on the command line: "max_radius" -> "--max-radius". */
+void cli_flag_name(const char *name, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s%.60s", strlen(name) == 1 ? "-" : "--", name);
+    for (char *p = buf + 2; *p; p++)
+        if (*p == '_')
+            *p = '-';
+}
+
+/* The list entry of option name read by method (NULL: any), or NULL. */
+static const cdl_option_info *find(const char *name, const char *method)
+{
+    for (int i = 0; i < cdl_option_count(); i++) {
+        const cdl_option_info *o = cdl_option_get(i);
+        if (!strcmp(o->name, name) && (!method || !o->integrators[0] || cli_reads(o->integrators, method)))
+            return o;
+    }
     return NULL;
+}
+
+int cli_reads(const char *list, const char *method)
+{
+    size_t n = strlen(method);
+    for (const char *p = list; *p;) {
+        const char *e = strchr(p, ',');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == n && !strncmp(p, method, n))
+            return 1;
+        p += len + (e != NULL);
+    }
+    return 0;
 }
 
 /* text from column col, wrapped at 80 columns, continuation lines indented */
@@ -75,43 +117,66 @@ static void wrapped(const char *text, int col, int indent)
     }
 }
 
-static void help(void)
+/* The options of method (NULL: all), by section. */
+static void help(const char *method)
 {
-    printf("usage: candela render SCENE [options]\n"
-           "\n"
-           "SCENE is a Wavefront OBJ file (materials from its MTL files), a pbrt-v3/v4\n"
-           "scene file (.pbrt) or a Mitsuba 0.6/3 scene file (.xml), whose camera, film,\n"
-           "sampler and integrator settings apply unless the options below override them.\n"
-           "Under mpirun (a build with MPI) the passes are split over the ranks and rank 0\n"
-           "writes the image: mpirun -np N candela render SCENE --threads T ...\n"
-           "\n"
-           "  -o, --output FILE       .exr (32-bit float), .png (sRGB) or .pfm; repeatable\n"
+    if (method)
+        printf("usage: candela render SCENE -i %s [options]\n\n", method);
+    else
+        printf("usage: candela render SCENE [options]\n"
+               "\n"
+               "SCENE is a Wavefront OBJ file (materials from its MTL files), a pbrt-v3/v4\n"
+               "scene file (.pbrt) or a Mitsuba 0.6/3 scene file (.xml), whose camera, film,\n"
+               "sampler and integrator settings apply unless the options below override them.\n"
+               "Under mpirun (a build with MPI) the passes are split over the ranks and rank 0\n"
+               "writes the image: mpirun -np N candela render SCENE --threads T ...\n"
+               "An option the method does not read is an error; candela render -i METHOD\n"
+               "--help lists that method's.\n"
+               "\n");
+    printf("  -o, --output FILE       .exr (32-bit float), .png (sRGB) or .pfm; repeatable\n"
            "                          (default: SCENE's name with .exr, in the current directory)\n");
     const char *section = "General";
     for (int i = 0; i < cdl_option_count(); i++) {
         const cdl_option_info *o = cdl_option_get(i);
+        if (method && o->integrators[0] && !cli_reads(o->integrators, method))
+            continue;
         if (strcmp(o->section, section)) {
             section = o->section;
             printf("\n%s:\n", section);
         }
-        char left[128], text[1024];
-        int one = strlen(o->name) == 1;
-        snprintf(left, sizeof left, "  %s%s%s%s%s", !strcmp(o->name, "integrator") ? "-i, " : !strcmp(o->name, "quiet") ? "-q, " : "    ",
-                 one ? "-" : "--", o->name, o->value[0] ? " " : "", o->value);
-        snprintf(text, sizeof text, "%s%s%s%s", o->help, o->value[0] && o->default_value[0] && !strstr(o->help, "default") ? " (default " : "",
-                 o->value[0] && o->default_value[0] && !strstr(o->help, "default") ? o->default_value : "",
-                 o->value[0] && o->default_value[0] && !strstr(o->help, "default") ? ")" : "");
+        char left[128], text[1200], flag[64];
+        cli_flag_name(o->name, flag, sizeof flag);
+        snprintf(left, sizeof left, "  %s%s%s%s", !strcmp(o->name, "integrator") ? "-i, " : !strcmp(o->name, "quiet") ? "-q, " : "    ",
+                 flag, o->value[0] ? " " : "", o->value);
+        int dflt = o->value[0] && o->default_value[0] && !strstr(o->help, "default");
+        snprintf(text, sizeof text, "%s%s%s%s", o->help, dflt ? " (default " : "", dflt ? o->default_value : "",
+                 dflt ? ")" : "");
         int len = (int)strlen(left);
         printf("%s%*s", left, len < 26 ? 26 - len : 2, "");
         wrapped(text, len < 26 ? 26 : len + 2, 26);
     }
-    printf("\nIntegrators:\n");
-    for (int i = 0; i < cdl_integrator_count(); i++) {
-        printf("  %-8s ", cdl_integrator_name(i));
-        wrapped(cdl_integrator_summary(i), 11, 11);
+    if (!method) {
+        printf("\nIntegrators:\n");
+        for (int i = 0; i < cdl_integrator_count(); i++) {
+            printf("  %-8s ", cdl_integrator_name(i));
+            wrapped(cdl_integrator_summary(i), 11, 11);
+        }
     }
     printf("\nThe summary line gives wall time, samples per pixel and Mrays/s (all rays\n"
            "traced divided by the render time). Ctrl-C writes the image so far (exit 130).\n");
+}
+
+/* -i METHOD (or --integrator METHOD) in argv, else NULL */
+static const char *method_arg(int argc, char **argv)
+{
+    const char *m = NULL;
+    for (int i = 1; i + 1 < argc; i++)
+        if (!strcmp(argv[i], "-i") || !strcmp(argv[i], "--integrator"))
+            m = argv[i + 1];
+    for (int i = 0; m && i < cdl_integrator_count(); i++)
+        if (!strcmp(cdl_integrator_name(i), m))
+            return m;
+    return NULL;
 }
 
 int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *err)
@@ -120,7 +185,7 @@ int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *er
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i];
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            help();
+            help(method_arg(argc, argv));
             return -1;
         }
         if (o[0] != '-' || !o[1]) {
@@ -140,20 +205,24 @@ int cli_parse(int argc, char **argv, cdl_settings *s, cli_args *a, cdl_error *er
             a->out[a->nout++] = argv[i];
             continue;
         }
-        const cdl_option_info *info = find(o);
-        if (!info || !info->value[0]) { /* a flag, or unknown: the library says which */
-            if ((rc = cdl_settings_set(s, o, NULL, err)))
+        char nb[64];
+        const char *name = option_name(o, nb, sizeof nb);
+        const cdl_option_info *info = name ? find(name, NULL) : NULL;
+        if (!info)
+            return set_error(err, CDL_ERR_USAGE, o, "unknown option (see candela render --help)%s", "");
+        if (!info->value[0]) { /* a bare switch */
+            if ((rc = cdl_settings_set(s, name, NULL, err)))
                 return rc;
-            a->quiet |= !strcmp(o, "-q") || !strcmp(o, "--quiet");
+            a->quiet |= !strcmp(name, "quiet");
             continue;
         }
         /* an option's value is the next argument, even one that starts
          * with '-' (so --spp -5 is an error about --spp) */
         if (i + 1 >= argc)
             return set_error(err, CDL_ERR_USAGE, o, "expects a value%s", "");
-        if ((rc = cdl_settings_set(s, o, argv[++i], err)))
+        if ((rc = cdl_settings_set(s, name, argv[++i], err)))
             return rc;
-        a->aov |= !strcmp(info->name, "aov");
+        a->aov |= !strcmp(name, "aov");
     }
     if (!a->scene)
         return set_error(err, CDL_ERR_USAGE, "render", "no scene file given (see candela render --help)%s", "");

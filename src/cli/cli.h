@@ -25,6 +25,10 @@ int cli_begin(int argc, char **argv, cdl_settings **s, cli_args *a, int *status)
 int cli_report(const cdl_error *err);
 /* 1 if path ends in ext (".exr"), case-insensitive. */
 int cli_has_ext(const char *path, const char *ext);
+/* "max_radius" -> "--max-radius" */
+void cli_flag_name(const char *name, char *buf, size_t n);
+/* whether method is in the comma-separated list */
+int cli_reads(const char *list, const char *method);
 
 int cli_render(int argc, char **argv);
 /* The output name when none is given: the scene file's, else SCENE.exr. */

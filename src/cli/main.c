@@ -5,8 +5,17 @@
 
 int cli_report(const cdl_error *err)
 {
+    /* a parameter the library names (max_radius) as the command line spells it */
+    cdl_error e = *err;
+    for (int i = 0; !e.line && i < cdl_option_count(); i++)
+        if (!strcmp(cdl_option_get(i)->name, e.file)) {
+            char flag[64];
+            cli_flag_name(e.file, flag, sizeof flag);
+            snprintf(e.file, sizeof e.file, "%s", flag);
+            break;
+        }
     char buf[2048];
-    cdl_error_format(err, buf, sizeof buf);
+    cdl_error_format(&e, buf, sizeof buf);
     fflush(stdout);
     fprintf(stderr, "candela: error: %s\n", buf);
     return err->code == CDL_ERR_USAGE ? 2 : 1;

@@ -38,7 +38,7 @@ void cdl_film_free(cdl_film *f)
 int cdl_film_add_aov(cdl_film *f, const char *name, int channels, cdl_error *err)
 {
     if (f->naovs >= CDL_MAX_AOVS || (channels != 1 && channels != 3)) {
-        cdl_error_set(err, CDL_ERR_USAGE, "--aov", 0, "too many output layers");
+        cdl_error_set(err, CDL_ERR_USAGE, "aov", 0, "too many output layers");
         return -1;
     }
     if (!f->aovs && !(f->aovs = calloc(CDL_MAX_AOVS, sizeof(cdl_aov)))) {

@@ -2,14 +2,14 @@
  * with every connection strategy, light tracing onto the film included.
  *
  * Options:
- *   --mis balance|power|stratified  weighting; stratified is Kollig &
+ *   mis balance|power|stratified  weighting; stratified is Kollig &
  *       Keller's heuristic (a connection x_i - y_j counts where
  *       G(x_i, y_j) < t and every earlier eye edge had G >= t)
- *   --threshold t    for stratified (default from the scene size)
- *   --light-paths K  K light paths per pass shared by all pixels (0: one
+ *   threshold t    for stratified (default from the scene size)
+ *   light_paths K  K light paths per pass shared by all pixels (0: one
  *       independent light path per pixel sample)
- *   --interleave N   N x N interleaved sets of the K paths
- *   --maxdepth N     bounces of the full path
+ *   interleave N   N x N interleaved sets of the K paths
+ *   maxdepth N     bounces of the full path
  * Without K, s = 1 resamples a light point per eye vertex (as pbrt-v3).
  * With K > 0 a pixel sample connects its eye path to every path of its
  * set; MIS weights count each strategy's samples (eye 1, connections
@@ -41,6 +41,8 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     st->walk.maxdepth = opt->maxdepth;
     st->walk.rr_depth = opt->rr_depth;
     st->threshold = cdl_default_threshold(scene, opt);
+    if (cdl_light_paths_check(opt, err))
+        return err->code;
     if (st->opt.light_paths == CDL_LIGHT_PATHS_PER_SAMPLE)
         st->opt.light_paths = 0; /* bdpt's default */
     st->walk.env_vertex = 1;
@@ -287,9 +289,18 @@ static void bdpt_destroy(void *self)
         cdl_light_pool_free(&st->pool);
 }
 
+static const cdl_param rows[] = {
+    {"mis", CDL_PARAM_CHOICE, "KIND", "power", "weights: balance, power, stratified (Kollig & Keller's heuristic on G "
+     "with threshold), or light (light tracing alone: every path through t = 1)",
+     .choices = "balance|power|stratified|light", CDL_PARAM_AT(cdl_options, mis)},
+};
+static const cdl_param_table table = CDL_PARAM_TABLE("Bidirectional path tracing (bdpt; Veach 1997)", rows);
+static const cdl_param_table *const tables[] = {&cdl_light_path_table, &table, NULL};
+
 const cdl_integrator_vtbl cdl_bdpt_integrator = {
+    .params = tables,
     .name = "bdpt",
-    .summary = "bidirectional path tracing, all strategies incl. light tracing; --mis, --light-paths, --interleave",
+    .summary = "bidirectional path tracing, all strategies incl. light tracing; mis, light_paths, interleave",
     .prepare = bdpt_prepare,
     .render_pass = bdpt_render_pass,
     .destroy = bdpt_destroy,

@@ -1,5 +1,7 @@
 #include "integrators/integrator.h"
 
+#include "core/common_params.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,47 +19,75 @@ static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt
                                                  &cdl_ir_integrator, &cdl_rigi_integrator,
                                                  &cdl_pm_integrator, &cdl_gkde_integrator, &cdl_splat_integrator, NULL};
 
+#define AT(f) CDL_PARAM_AT(cdl_options, f)
+
+static const cdl_param density_rows[] = {
+    {"progressive", CDL_PARAM_BOOL, "on|off", "on",
+     "consistent: every bandwidth (pm's radii, gkde's h, splat's kernels) shrinks with the pass index i as r_i^2 = "
+     "r_0^2 prod (j + alpha) / (j + 1) (Knaus & Zwicker 2011), so the bias falls with time; off: the fixed "
+     "bandwidths of the reports",
+     AT(progressive)},
+    {"alpha", CDL_PARAM_FLOAT, "a", "2/3",
+     "radius reduction: r^2 falls about as i^(alpha - 1); smaller shrinks faster with more noise", 0, 1,
+     .note = "1 keeps the bandwidths fixed, 0 lets the noise grow", .flags = CDL_PARAM_OPEN_MIN | CDL_PARAM_OPEN_MAX,
+     AT(alpha)},
+};
+const cdl_param_table cdl_density_table = CDL_PARAM_TABLE("Density estimation (pm, gkde, splat)", density_rows);
+
+static const cdl_param photon_rows[] = {
+    {"photons", CDL_PARAM_INT, "N", "200000",
+     "photons stored per pass: pm's global map (paths are traced until it holds N), splat's photon rays of all "
+     "budgets",
+     1, 5e8, AT(photons)},
+};
+const cdl_param_table cdl_photon_table = CDL_PARAM_TABLE("Photons (pm, splat)", photon_rows);
+
+static const double per_sample[] = {CDL_LIGHT_PATHS_PER_SAMPLE};
+static const cdl_param light_path_rows[] = {
+    {"light_paths", CDL_PARAM_INT, "K|sample", "",
+     "K light paths per pass shared by all pixels, or 'sample': an independent one per pixel sample (bdpt default: "
+     "sample; ir/rigi default 256 paths in 4 x 4 interleaved sets)",
+     1, 1e8, .choices = "sample", .values = per_sample, AT(light_paths)},
+    {"interleave", CDL_PARAM_INT, "N", "1", "N x N interleaved sets of the K light paths", 1, 64, AT(interleave)},
+    {"threshold", CDL_PARAM_FLOAT, "t", "",
+     "stratification threshold on G (rigi; bdpt's stratified weights; ir's clamp by default): the scene's "
+     "diagonal d gives t = 1 / (0.15 d)^2; printed when used",
+     1e-12, 1e12, AT(threshold)},
+};
+const cdl_param_table cdl_light_path_table =
+    CDL_PARAM_TABLE("Shared light paths (bdpt, ir, rigi; Kollig & Keller 2004)", light_path_rows);
+
+static const cdl_param shadow_rows[] = {
+    {"shadow_mode", CDL_PARAM_CHOICE, "KIND", "bundle",
+     "bundle (one Embree ray stream per point light and tile, or per footprint) or single (one by one, for "
+     "comparison)",
+     .choices = "bundle|single", AT(single_shadow_rays)},
+};
+const cdl_param_table cdl_shadow_table = CDL_PARAM_TABLE("Shadow rays to points (ir, rigi, gkde)", shadow_rows);
+
 void cdl_options_default(cdl_options *o)
 {
     memset(o, 0, sizeof *o);
-    o->maxdepth = 64;
     o->rr_depth = 3;
-    o->seed = 1;
-    o->mis = CDL_MIS_POWER;
-    o->interleave = 1;
-    o->progressive = 1;
-    o->alpha = 2.0f / 3.0f;
-    o->pm.photons = 200000;
-    o->pm.k = 20;
-    o->pm.kernel = 1; /* cone */
-    o->pm.gather = 8;
-    o->pm.precompute = 4;
-    o->pm.importons = 1u << 17;
-    o->pm.eps = 0.01f;
-    o->pm.caustic_ratio = 1.0f;
-    o->pm.shadow_rays = 4;
-    o->pm.visibility = CDL_PM_VIS_ALL;
-    o->gkde.eye_paths = 1;
-    o->gkde.links = 0; /* tied to the light paths (gkde.h) */
-    o->gkde.footprint_cap = 2.0f;
-    o->gkde.overlaps = 2.0f;
-    o->gkde.max_mib = 4096;
-    o->splat.photons = 200000;
-    o->splat.fractions[0] = 0.3f;
-    o->splat.fractions[1] = 0.6f;
-    o->splat.fractions[2] = 0.1f;
-    o->splat.C = 0.5f;
-    o->splat.S = 0.4f;
-    o->splat.R = 0.2f;
-    o->splat.mode = CDL_SPLAT_DIRECT;
-    o->splat.eye_samples = 1;
-    o->splat.cull = 1;
-    o->splat.filter_normal = 20.0f;
-    o->splat.filter_depth = 0.05f;
-    o->splat.filter_max = 25;
-    o->splat.cache_min = 5;
-    o->splat.cap = 4.0f;
-    o->splat.occlusion = 1;
+    cdl_common_params c;
+    cdl_common_default(&c);
+    o->maxdepth = (int)c.maxdepth;
+    o->seed = (uint64_t)c.seed;
+    o->sampler = (cdl_sampler_kind)c.sampler;
+    for (int i = 0; all[i]; i++)
+        for (const cdl_param_table *const *t = all[i]->params; t && *t; t++)
+            cdl_param_defaults(*t, o);
+}
+
+int cdl_light_paths_check(const cdl_options *opt, cdl_error *err)
+{
+    if (opt->interleave > 1 && (!opt->light_paths || opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE))
+        return cdl_error_set(err, CDL_ERR_USAGE, "interleave", 0, "needs light_paths K (the paths to interleave)");
+    if (opt->light_paths && opt->light_paths != CDL_LIGHT_PATHS_PER_SAMPLE &&
+        opt->light_paths < opt->interleave * opt->interleave)
+        return cdl_error_set(err, CDL_ERR_USAGE, "light_paths", 0, "%u paths cannot fill %u x %u interleaved sets",
+                             opt->light_paths, opt->interleave, opt->interleave);
+    return 0;
 }
 
 float cdl_progressive_r2(const cdl_options *opt, uint32_t pass)

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "core/params.h"
 #include "core/stats.h"
 #include "core/sampler.h"
 #include "transport/mis.h"
@@ -15,11 +16,10 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
-#define CDL_STRATA 8 /* --aov strata: eye path lengths 1..7 and 8 or more */
+#define CDL_STRATA 8 /* aov strata: eye path lengths 1..7 and 8 or more */
 
 /* pm: Jensen's photon map with the techniques of Keller & Wald 2000 */
 typedef struct cdl_pm_options {
-    uint32_t photons;       /* global photons stored per pass */
     uint32_t k;             /* photons per radiance estimate */
     float max_radius;       /* of an estimate; <= 0: 5 % of the scene's diagonal */
     int kernel;             /* cdl_kernel */
@@ -31,7 +31,7 @@ typedef struct cdl_pm_options {
     int discard;            /* drop photons below eps instead (biased) */
     float caustic_ratio;    /* q (§2.2) */
     int caustic_random;     /* per-photon test against q instead of the path prefix */
-    int direct;             /* cdl_direct_kind */
+    int direct;             /* cdl_direct_kind, or CDL_PM_DIRECT_PHOTONS as given */
     int direct_photons;     /* direct light from the map's primary photons (needs gather 0) */
     uint32_t shadow_rays;   /* S */
     float lcon_radius;      /* L_con query radius; <= 0: the maximum radius */
@@ -39,14 +39,18 @@ typedef struct cdl_pm_options {
     int visibility;         /* cdl_pm_visibility: which estimates test photon visibility */
 } cdl_pm_options;
 
+/* pm's direct = photons: read from the map (pm.direct_photons), not a light selection */
+#define CDL_PM_DIRECT_PHOTONS 16
+
 typedef enum {
     CDL_PM_VIS_GATHER, /* estimates at final-gather hits and the precomputed irradiance */
-    CDL_PM_VIS_ALL,    /* also at the camera's point (--gather 0, caustics) */
+    CDL_PM_VIS_ALL,    /* also at the camera's point (gather 0, caustics) */
     CDL_PM_VIS_OFF     /* none: Jensen's estimate, which leaks through thin walls */
 } cdl_pm_visibility;
 
 /* gkde: generalized kernel density estimation (Bekaert et al. 2003) */
 typedef struct cdl_gkde_options {
+    uint32_t light_paths; /* N: light paths per step */
     uint32_t eye_paths;  /* eye paths per pixel and step */
     uint32_t links;      /* M: unoccluded links wanted per eye vertex (§5); 0: one per 10000 light paths */
     float bandwidth;     /* h of eq. 7; <= 0: calibrated in the first step */
@@ -59,11 +63,13 @@ typedef struct cdl_gkde_options {
 /* splat: photon ray splatting (Herzog et al. 2007) */
 typedef enum { CDL_SPLAT_DIRECT, CDL_SPLAT_HISTOGRAM, CDL_SPLAT_SH } cdl_splat_mode;
 
+typedef enum { CDL_SPLAT_DIRECT_PHOTONS, CDL_SPLAT_DIRECT_SAMPLE, CDL_SPLAT_DIRECT_NONE } cdl_splat_direct;
+
 typedef struct cdl_splat_options {
-    uint32_t photons;    /* photon rays stored per pass, all budgets */
     float fractions[3];  /* direct, indirect, caustic shares of the budget */
     float C, S, R;       /* bandwidth smoothness, sensitivity, clamping (§4.2) */
     int mode;            /* cdl_splat_mode: how the radiance maps hold incident light */
+    int direct;          /* cdl_splat_direct, as given; prepare derives the two below */
     int direct_sample;   /* direct light by light sampling instead of direct photons */
     int direct_none;     /* no direct light at the camera's points (indirect light alone) */
     uint32_t eye_samples; /* eye samples per pixel and pass */
@@ -85,6 +91,9 @@ typedef struct cdl_splat_options {
 } cdl_splat_options;
 
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
+
+/* extra image layers (cdl_options.aov bits) */
+enum { CDL_AOV_PATHLENGTH = 1, CDL_AOV_STRATA = 2, CDL_AOV_BANDWIDTH = 4, CDL_AOV_RECORDS = 8 };
 
 typedef struct cdl_options {
     cdl_camera camera;
@@ -109,6 +118,8 @@ typedef struct cdl_options {
      * with the pass index (cdl_progressive_r2); off: the reports' fixed ones */
     int progressive;
     float alpha;
+    uint32_t photons; /* pm, splat: photons (splat: photon rays, all budgets) stored per pass */
+    uint32_t aov;     /* CDL_AOV_* layers asked for (rigi, splat) */
 
     cdl_pm_options pm;
     cdl_gkde_options gkde;
@@ -119,7 +130,17 @@ typedef struct cdl_options {
  * "cheaper rays" of rigi to 15 % of the scene's diagonal (r <= sqrt(1/t)). */
 float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt);
 
+/* Every method's defaults, from their parameter tables. */
 void cdl_options_default(cdl_options *o);
+
+/* Rows shared by several methods (each lists the tables it reads):
+ * progressive and alpha (pm, gkde, splat), photons (pm, splat), light
+ * paths, interleave and threshold (bdpt, ir, rigi), shadow_mode (ir,
+ * rigi, gkde). */
+extern const cdl_param_table cdl_density_table, cdl_photon_table, cdl_light_path_table, cdl_shadow_table;
+
+/* light_paths and interleave together (bdpt, ir, rigi) */
+int cdl_light_paths_check(const cdl_options *opt, cdl_error *err);
 
 /* Progressive radius reduction (Knaus & Zwicker 2011, eq. 20): the squared
  * bandwidth of pass i (0-based) relative to pass 0's,
@@ -132,7 +153,7 @@ float cdl_progressive_r2(const cdl_options *opt, uint32_t pass);
 
 typedef struct cdl_integrator_vtbl {
     const char *name;
-    const char *summary; /* one line for --help */
+    const char *summary; /* one line for help */
     /* Both return 0 or an error code with err filled in (file, problem). */
     int (*prepare)(void *self, const cdl_scene *scene, const cdl_options *opt, cdl_error *err);
     int (*render_pass)(void *self, cdl_film *film, uint32_t pass, cdl_error *err);
@@ -147,6 +168,8 @@ typedef struct cdl_integrator_vtbl {
     void (*adapt_get)(const void *self, double *out);
     void (*adapt_fold)(void *self, const double *sum);
     size_t self_size;
+    /* the parameter tables the method reads (beyond the common one), NULL-terminated */
+    const cdl_param_table *const *params;
 } cdl_integrator_vtbl;
 
 typedef struct cdl_integrator {

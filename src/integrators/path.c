@@ -6,7 +6,7 @@
  * power heuristic (Veach 1997, ch. 9). Russian roulette on the throughput
  * after opt.rr_depth bounces, survival at least 5 %.
  *
- * Options: --maxdepth N  bounces (1 = direct light only), default 64.
+ * Options: maxdepth N  bounces (1 = direct light only), default 64.
  */
 #include <float.h>
 

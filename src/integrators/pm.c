@@ -5,15 +5,15 @@
  * the shared tracer, deposited into a global and a caustic map), then one
  * sample per pixel: the camera ray follows specular surfaces (collecting
  * emission) to the first non-specular point x, where
- *   direct light    light sampling (--direct power | lcon | lcon-biased),
+ *   direct light    light sampling (direct power | lcon | lcon-biased),
  *   caustics        the caustic map (photons last scattered specularly),
- *   indirect light  --gather N rays from x by BSDF sampling, each querying
+ *   indirect light  gather N rays from x by BSDF sampling, each querying
  *                   both maps where it lands (rays that land on a specular
  *                   surface carry caustics: they are the caustic map's part);
- *                   --gather 0 queries the global map at x without its
+ *                   gather 0 queries the global map at x without its
  *                   primary photons (direct visualization).
  * Passes average. By default every estimate's radius (the k nearest's,
- * within --max-radius) is scaled by the pass's factor of progressive
+ * within max_radius) is scaled by the pass's factor of progressive
  * photon mapping (Knaus & Zwicker 2011; cdl_progressive_r2), so the bias
  * falls with the passes as the noise does. Their probabilistic form is the
  * one that fits here: each pass is an independent estimate whose radius
@@ -21,8 +21,8 @@
  * camera's point, the final-gather hits, the precomputed irradiance and
  * the caustic map alike, and passes can still be split over processes;
  * Hachisuka & Jensen's per-pixel statistics exist only for the camera's
- * points. --progressive off: Jensen's fixed k-NN estimate, whose bias
- * shrinks only with --photons. */
+ * points. progressive off: Jensen's fixed k-NN estimate, whose bias
+ * shrinks only with photons. */
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -112,6 +112,11 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     pm_state *st = self;
     st->scene = scene;
     st->opt = *opt;
+    opt = &st->opt;
+    if (st->opt.pm.direct == CDL_PM_DIRECT_PHOTONS) {
+        st->opt.pm.direct_photons = 1;
+        st->opt.pm.direct = CDL_DIRECT_POWER;
+    }
     st->walk.maxdepth = opt->maxdepth;
     st->walk.rr_depth = opt->rr_depth;
     st->traced_pass = UINT32_MAX;
@@ -125,20 +130,22 @@ static int pm_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     float rl = opt->pm.lcon_radius > 0.0f ? opt->pm.lcon_radius : r;
     st->lcon_r2 = rl * rl;
     if (opt->pm.k < 1 || opt->pm.k > 4096)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--knn", 0, "must be in [1, 4096]");
+        return cdl_error_set(err, CDL_ERR_USAGE, "knn", 0, "must be in [1, 4096]");
     if (!(opt->pm.caustic_ratio > 0.0f && opt->pm.caustic_ratio <= 1.0f))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--caustic-ratio", 0, "must be in (0, 1]");
+        return cdl_error_set(err, CDL_ERR_USAGE, "caustic_ratio", 0, "must be in (0, 1]");
     if (!(opt->pm.eps > 0.0f && opt->pm.eps <= 1.0f))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--importance-eps", 0, "must be in (0, 1]");
+        return cdl_error_set(err, CDL_ERR_USAGE, "importance_eps", 0, "must be in (0, 1]");
+    if (opt->pm.discard && !opt->pm.importance)
+        return cdl_error_set(err, CDL_ERR_USAGE, "importance_discard", 0, "needs importance");
     if (opt->pm.direct_photons && opt->pm.gather)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--direct", 0,
-                             "photons (direct light read from the photon map) needs --gather 0");
+        return cdl_error_set(err, CDL_ERR_USAGE, "direct", 0,
+                             "photons (direct light read from the photon map) needs gather 0");
     if (opt->pm.precompute == 1)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
+        return cdl_error_set(err, CDL_ERR_USAGE, "precompute", 0,
                              "must be 0 (off) or at least 2: the photons that carry irradiance points "
                              "cannot also estimate there");
     if (opt->pm.visibility < CDL_PM_VIS_GATHER || opt->pm.visibility > CDL_PM_VIS_OFF)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--visibility", 0, "unknown kind %d", opt->pm.visibility);
+        return cdl_error_set(err, CDL_ERR_USAGE, "visibility", 0, "unknown kind %d", opt->pm.visibility);
     cdl_vis vis = {cdl_photon_vis_origin, cdl_photon_visible, scene}, none = {0};
     st->vis_gather = opt->pm.visibility != CDL_PM_VIS_OFF ? vis : none;
     st->vis_camera = opt->pm.visibility == CDL_PM_VIS_ALL ? vis : none;
@@ -168,8 +175,8 @@ int cdl_pm_photon_setup(const cdl_scene *s, const cdl_options *opt, const cdl_wa
                         cdl_photon_params *pp, cdl_importance *imp, cdl_error *err)
 {
     const cdl_pm_options *o = &opt->pm;
-    *pp = (cdl_photon_params){o->photons, o->caustic_ratio, o->caustic_random, NULL, o->eps, o->discard,
-                              o->max_paths ? o->max_paths : cdl_photons_default_max_paths(o->photons)};
+    *pp = (cdl_photon_params){opt->photons, o->caustic_ratio, o->caustic_random, NULL, o->eps, o->discard,
+                              o->max_paths ? o->max_paths : cdl_photons_default_max_paths(opt->photons)};
     if (!o->importance)
         return 0;
     int rc = cdl_importance_build(imp, s, &opt->camera, walk, o->importons, 1024, max_radius, opt->sampler,
@@ -227,7 +234,7 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
     }
     cdl_vec3 Lx = cdl_direct_light(s, &st->dcfg, &w->lc, &sf, &b, wo, smp, rays, nlcon);
     if (depth + 1 < st->opt.maxdepth) {
-        /* --maxdepth counts the whole path: the photons here may have met
+        /* maxdepth counts the whole path: the photons here may have met
          * as many surfaces as the camera path has bounces left */
         uint32_t left = (uint32_t)(st->opt.maxdepth - depth);
         w->qcx.max_depth = left;
@@ -326,7 +333,7 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
 static int pm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error *err)
 {
     pm_state *st = self;
-    /* direct light only (--maxdepth 1) reads no photon map but L_con's,
+    /* direct light only (maxdepth 1) reads no photon map but L_con's,
      * which the first pass built: no photons to trace */
     if (st->traced_pass != pass && (st->opt.maxdepth > 1 || st->opt.pm.direct_photons)) {
         int rc = trace(st, pass, &film->rays, err);
@@ -378,7 +385,52 @@ static void pm_destroy(void *self)
         cdl_importance_free(&st->imp);
 }
 
+#define AT(f) CDL_PARAM_AT(cdl_options, pm.f)
+static const double direct_kinds[] = {CDL_DIRECT_POWER, CDL_DIRECT_LCON, CDL_DIRECT_LCON_BIASED, CDL_PM_DIRECT_PHOTONS,
+                                      CDL_DIRECT_NONE};
+static const cdl_param rows[] = {
+    {"knn", CDL_PARAM_INT, "K", "20", "photons per radiance estimate (their radius, scaled by the pass's factor when "
+     "progressive)", 1, 4096, AT(k)},
+    {"max_radius", CDL_PARAM_FLOAT, "R", "", "largest estimate radius (default 5 % of the scene's diagonal)", 1e-9,
+     1e9, AT(max_radius)},
+    {"kernel", CDL_PARAM_CHOICE, "KIND", "cone", "box, cone or epanechnikov", .choices = "box|cone|epanechnikov",
+     AT(kernel)},
+    {"gather", CDL_PARAM_INT, "N", "8", "final gathering rays per pixel sample; 0 shows the global map directly", 0,
+     65536, AT(gather)},
+    {"precompute", CDL_PARAM_INT, "M", "4", "gather rays landing on Lambertian surfaces read the irradiance "
+     "precomputed at 1 in M photons from the others (Christensen 1999; 0 = a full estimate; M >= 2)", 0, 1e6,
+     AT(precompute)},
+    {"visibility", CDL_PARAM_CHOICE, "V", "all", "which estimates leave out photons no free path joins to the query "
+     "point (a shadow ray each): all (no light in a room that no light path enters), gather (only those at "
+     "final-gather hits, incl. the precomputed irradiance: gather 0 and caustics at the camera's point may leak) or "
+     "off (Jensen's: leaks through thin walls)", .choices = "gather|all|off", AT(visibility)},
+    {"caustic_ratio", CDL_PARAM_FLOAT, "q", "1", "only a fraction q of the paths fills the global map, all fill the "
+     "caustic map", 0, 1, .flags = CDL_PARAM_OPEN_MIN, AT(caustic_ratio)},
+    {"caustic_select", CDL_PARAM_CHOICE, "S", "prefix", "prefix (the first q N paths) or random (a test against q "
+     "per photon)", .choices = "prefix|random", AT(caustic_random)},
+    {"importance", CDL_PARAM_BOOL, "", "off", "store photons with probability p = min(1, f I(x)) from importons "
+     "traced from the camera (power L / p)", .flags = CDL_PARAM_FLAG, AT(importance)},
+    {"importons", CDL_PARAM_INT, "N", "131072", "importon paths", 1, 1e8, AT(importons)},
+    {"importance_eps", CDL_PARAM_FLOAT, "e", "0.01", "lower bound of p (unbiased)", 0, 1,
+     .note = "a zero bound drops photons no importon saw: biased", .flags = CDL_PARAM_OPEN_MIN, AT(eps)},
+    {"importance_discard", CDL_PARAM_BOOL, "", "off", "drop photons with p < e instead (biased)",
+     .flags = CDL_PARAM_FLAG, AT(discard)},
+    {"direct", CDL_PARAM_CHOICE, "KIND", "power", "power (lights in proportion to power), lcon (S rays to the lights "
+     "of nearby primary photons, one to the rest), lcon-biased (none to the rest), photons (read from the photon "
+     "map: its primary photons seen directly; needs gather 0) or none (indirect light alone, for comparisons)",
+     .choices = "power|lcon|lcon-biased|photons|none", .values = direct_kinds, AT(direct)},
+    {"shadow_rays", CDL_PARAM_INT, "S", "4", "direct-light shadow rays per shading point", 1, 4096, AT(shadow_rays)},
+    {"lcon_radius", CDL_PARAM_FLOAT, "R", "", "radius of the L_con query (default: max_radius)", 1e-9, 1e9,
+     AT(lcon_radius)},
+    {"photon_paths_max", CDL_PARAM_INT, "N", "", "give up when N paths per pass have not stored the photons (default "
+     "1000 per photon, at least 2^20)", 1, 2147483647.0, AT(max_paths)},
+};
+#undef AT
+static const cdl_param_table table = CDL_PARAM_TABLE("Photon mapping (pm; Jensen 1996 with Keller & Wald 2000)", rows);
+static const cdl_param_table *const tables[] = {&cdl_density_table, &cdl_photon_table, &table, NULL};
+
 const cdl_integrator_vtbl cdl_pm_integrator = {
+    .params = tables,
     .name = "pm",
     .summary = "photon mapping with importons, automatic caustics and L_con (Keller & Wald 2000)",
     .prepare = pm_prepare,

@@ -3,9 +3,9 @@
  *
  * Point lights are the vertices of K light paths per pass (the shared
  * light pool; y_0 on the emitters included), split into N x N interleaved
- * sets (--light-paths K, --interleave N; default 256 in 4 x 4 sets, 16 point-light
+ * sets (light_paths K, interleave N; default 256 in 4 x 4 sets, 16 point-light
  * paths per pixel sample, about 1 s per pass at 512 x 512 on 2 cores), or
- * one independent light path per pixel sample (--light-paths sample: the
+ * one independent light path per pixel sample (light_paths sample: the
  * "pure Monte Carlo" left column of the report's Figure 6).
  *
  * rigi: at each eye vertex x_i, a shadow ray goes only to point lights
@@ -14,12 +14,12 @@
  * only if G(x_i, x_{i+1}) >= t; emitters hit by a continued path add L_e.
  * At specular vertices the path always continues (no connection is
  * possible there). This is bdpt with the stratification heuristic, so it
- * is unbiased. --strata distance thresholds 1 / d^2 instead of G (Fig. 2c).
+ * is unbiased. strata distance thresholds 1 / d^2 instead of G (Fig. 2c).
  * Shadow rays towards one point light are traced together, as a bundle
  * from all eye vertices of a 16 x 16 tile (Embree ray stream).
  *
  * ir: the first diffuse eye vertex connects to every point light of its
- * set with G clamped at --clamp (Fig. 2a): biased, darker in corners.
+ * set with G clamped at clamp (Fig. 2a): biased, darker in corners.
  *
  * Lights at infinity (distant, infinite): their light paths start on the
  * disk covering the scene, which is no point light; their vertices from
@@ -71,11 +71,11 @@ static int prepare(void *self, const cdl_scene *scene, const cdl_options *opt, i
     st->at_infinity = 0;
     for (uint32_t i = 0; i < scene->nlights; i++)
         st->at_infinity |= cdl_light_at_infinity(&scene->lights[i]);
+    if (cdl_light_paths_check(opt, err))
+        return err->code;
     st->per_sample = opt->light_paths == CDL_LIGHT_PATHS_PER_SAMPLE;
     if (st->per_sample)
-        return opt->interleave > 1 ? cdl_error_set(err, CDL_ERR_USAGE, "--interleave", 0,
-                                                   "needs --light-paths K (the paths to interleave)")
-                                   : 0;
+        return 0;
     uint32_t k = opt->light_paths ? opt->light_paths : 256;
     uint32_t n = opt->light_paths ? opt->interleave : 4;
     if (cdl_light_pool_init(&st->pool, k, n, opt->maxdepth, err))
@@ -93,7 +93,7 @@ static int ir_prepare(void *self, const cdl_scene *scene, const cdl_options *opt
     return prepare(self, scene, opt, 1, err);
 }
 
-/* The stratification function: G, or 1 / d^2 for --strata distance. */
+/* The stratification function: G, or 1 / d^2 for strata distance. */
 static float strata_g(const rigi_state *st, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_vec3 nb)
 {
     if (!st->opt.strata_distance)
@@ -106,7 +106,7 @@ static float strata_g(const rigi_state *st, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 p
 /* One candidate shadow ray of a tile: eye vertex -> point light. */
 typedef struct candidate {
     uint32_t pixel;
-    uint32_t depth; /* eye path length at the connecting vertex, for --aov strata */
+    uint32_t depth; /* eye path length at the connecting vertex, for aov strata */
     cdl_vec3 c; /* contribution if unoccluded */
     cdl_vec3 o, d;
     float tmax;
@@ -264,7 +264,7 @@ static void connect_set(const rigi_state *st, const cdl_light_pool *lp, tile_wor
             if (j == 0 && st->scene->lights[lv->light[y]].type == CDL_LIGHT_SPHERE)
                 skip = st->scene->lights[lv->light[y]].prim;
             w->ncand = 0;
-            /* --maxdepth counts the whole path: x_1 .. x_i then y_j .. y_1 */
+            /* maxdepth counts the whole path: x_1 .. x_i then y_j .. y_1 */
             int room = st->opt.maxdepth - (int)lv->depth[y] - 1;
             for (uint32_t a = 0; a < nverts; a++) {
                 uint32_t e = verts[a];
@@ -347,7 +347,7 @@ static uint64_t rigi_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
     cdl_vs_init(&w->eye);
     cdl_vec3 acc[256];
     int pix_sets[256];
-    /* --light-paths sample: the tile's own pool, pixel p's path in set p */
+    /* light_paths sample: the tile's own pool, pixel p's path in set p */
     cdl_light_pool local;
     const cdl_light_pool *lp = &st->pool;
     if (st->per_sample) {
@@ -445,7 +445,25 @@ static void rigi_destroy(void *self)
     cdl_light_pool_free(&st->pool);
 }
 
+static const double aov_bits[] = {CDL_AOV_PATHLENGTH, CDL_AOV_STRATA};
+static const cdl_param rigi_rows[] = {
+    {"strata", CDL_PARAM_CHOICE, "KIND", "geometry", "geometry (threshold G) or distance (threshold 1 / d^2, Fig. 2c)",
+     .choices = "geometry|distance", CDL_PARAM_AT(cdl_options, strata_distance)},
+    {"aov", CDL_PARAM_CHOICE, "NAME", "", "extra EXR layers, repeatable: pathlength (average eye path length, Fig. 4) "
+     "or strata (the contribution of each eye path length as layers strata1..strata8, Fig. 5)",
+     .choices = "pathlength|strata", .values = aov_bits, .flags = CDL_PARAM_BITS, CDL_PARAM_AT(cdl_options, aov)},
+};
+static const cdl_param ir_rows[] = {
+    {"clamp", CDL_PARAM_FLOAT, "c", "", "clamp G at c (default: the threshold, 1 / (0.15 d)^2 for the scene's "
+     "diagonal d)", 1e-12, 1e12, CDL_PARAM_AT(cdl_options, clamp)},
+};
+static const cdl_param_table rigi_table = CDL_PARAM_TABLE("Robust instant GI (rigi; Kollig & Keller 2004)", rigi_rows);
+static const cdl_param_table ir_table = CDL_PARAM_TABLE("Instant radiosity (ir; Keller 1997)", ir_rows);
+static const cdl_param_table *const rigi_tables[] = {&cdl_light_path_table, &cdl_shadow_table, &rigi_table, NULL};
+static const cdl_param_table *const ir_tables[] = {&cdl_light_path_table, &cdl_shadow_table, &ir_table, NULL};
+
 const cdl_integrator_vtbl cdl_rigi_integrator = {
+    .params = rigi_tables,
     .name = "rigi",
     .summary = "robust instant GI (Kollig & Keller 2004): point lights below G < t, eye path beyond",
     .prepare = rigi_prepare,
@@ -455,8 +473,9 @@ const cdl_integrator_vtbl cdl_rigi_integrator = {
 };
 
 const cdl_integrator_vtbl cdl_ir_integrator = {
+    .params = ir_tables,
     .name = "ir",
-    .summary = "instant radiosity (Keller 1997), G clamped at --clamp (biased)",
+    .summary = "instant radiosity (Keller 1997), G clamped at clamp (biased)",
     .prepare = ir_prepare,
     .render_pass = rigi_render_pass,
     .destroy = rigi_destroy,

@@ -4,19 +4,19 @@ int cdl_camera_init(cdl_camera *c, cdl_vec3 eye, cdl_vec3 target, cdl_vec3 up,
                     float fov_deg, int width, int height, cdl_error *err)
 {
     if (!(fov_deg > 0.0f && fov_deg < 180.0f))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--fov", 0,
+        return cdl_error_set(err, CDL_ERR_USAGE, "fov", 0,
                              "field of view must be in (0, 180) degrees, got %g", (double)fov_deg);
     if (width <= 0 || height <= 0)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--res", 0, "resolution must be positive");
+        return cdl_error_set(err, CDL_ERR_USAGE, "res", 0, "resolution must be positive");
     cdl_vec3 f = cdl_sub(target, eye);
     float fl = cdl_length(f);
     if (!(fl > 0.0f) || !isfinite(fl))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--lookat", 0, "eye and target must differ");
+        return cdl_error_set(err, CDL_ERR_USAGE, "lookat", 0, "eye and target must differ");
     f = cdl_scale(f, 1.0f / fl);
     cdl_vec3 r = cdl_cross(f, up);
     float rl = cdl_length(r);
     if (!(rl > 1e-6f * cdl_length(up)) || !isfinite(rl))
-        return cdl_error_set(err, CDL_ERR_USAGE, "--lookat", 0,
+        return cdl_error_set(err, CDL_ERR_USAGE, "lookat", 0,
                              "up vector must not be parallel to the view direction");
     c->eye = eye;
     c->fwd = f;
@@ -36,7 +36,7 @@ int cdl_camera_init_frame(cdl_camera *c, cdl_vec3 eye, cdl_vec3 right, cdl_vec3 
         return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "field of view must be in (0, 180) degrees, got %g",
                              (double)fov_deg);
     if (width <= 0 || height <= 0)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--res", 0, "resolution must be positive");
+        return cdl_error_set(err, CDL_ERR_USAGE, "res", 0, "resolution must be positive");
     cdl_vec3 det = cdl_cross(right, up);
     if (!cdl_is_finite3(eye) || !cdl_is_finite3(fwd) || !(fabsf(cdl_dot(det, fwd)) > 1e-12f))
         return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "camera transform is singular or not finite");

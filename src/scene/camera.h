@@ -7,7 +7,7 @@
 #include "core/vec.h"
 
 typedef struct cdl_camera {
-    cdl_vec3 eye, fwd, right, up; /* world images of camera z, x, y (orthonormal for --lookat) */
+    cdl_vec3 eye, fwd, right, up; /* world images of camera z, x, y (orthonormal for lookat) */
     float tan_half;               /* tan(vertical fov / 2) */
     float aspect;                 /* width / height */
     int width, height;

@@ -1,11 +1,12 @@
 #include "scene/scene.h"
 
-#include "core/grow.h"
-
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "core/grow.h"
+#include "core/log.h"
 
 
 static void embree_error(void *user, enum RTCError code, const char *str)
@@ -353,7 +354,7 @@ static int build_lights(cdl_scene *s, cdl_error *err)
     }
     if (s->nlights == 0)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
-                             "scene has no light (no emitting surface and no --point-light)");
+                             "scene has no light (no emitting surface and no point_light)");
     float *w = malloc(sizeof(float) * s->nlights);
     if (!w)
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
@@ -535,4 +536,18 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
     if (m->kd_tex >= 0)
         kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
+}
+
+void cdl_scene_settings_param(cdl_scene_settings *set, const char *name, const char *value, const char *file,
+                              int line)
+{
+    if (set->nparams == CDL_MAX_SCENE_PARAMS) {
+        cdl_warn(file, line, "more than %d integrator parameters: \"%s\" ignored", CDL_MAX_SCENE_PARAMS, name);
+        return;
+    }
+    cdl_scene_param *p = &set->params[set->nparams++];
+    snprintf(p->name, sizeof p->name, "%s", name);
+    snprintf(p->value, sizeof p->value, "%s", value);
+    snprintf(p->file, sizeof p->file, "%s", file);
+    p->line = line;
 }

@@ -27,6 +27,16 @@ typedef struct cdl_emitter {
     int twosided; /* triangles: both faces emit; otherwise the CCW front face */
 } cdl_emitter;
 
+/* A parameter of the file's integrator block, as text, for the method's
+ * table to read (api/resolve.c) or warn about. */
+#define CDL_MAX_SCENE_PARAMS 32
+typedef struct cdl_scene_param {
+    char name[32];
+    char value[96];
+    char file[256];
+    int line;
+} cdl_scene_param;
+
 /* What a scene file says about rendering; the command line overrides it. */
 typedef struct cdl_scene_settings {
     int has_camera;                 /* eye/right/up/fwd/fov are set */
@@ -35,9 +45,17 @@ typedef struct cdl_scene_settings {
     int width, height;              /* 0 = not given */
     int spp;                        /* 0 = not given */
     int maxdepth;                   /* -1 = not given */
-    char integrator[32];            /* candela integrator name, "" = not given */
+    char integrator[32];            /* the file's integrator (a candela name or not), "" = not given */
+    char integrator_file[256];      /* where it was given */
+    int integrator_line;
     char filename[1024];            /* the file's output image name, "" = not given */
+    cdl_scene_param params[CDL_MAX_SCENE_PARAMS]; /* the integrator block's other parameters */
+    int nparams;
 } cdl_scene_settings;
+
+/* Adds an integrator parameter; past CDL_MAX_SCENE_PARAMS, a warning. */
+void cdl_scene_settings_param(cdl_scene_settings *set, const char *name, const char *value, const char *file,
+                              int line);
 
 /* Also the public API's scene handle (candela.h). */
 typedef struct cdl_scene {

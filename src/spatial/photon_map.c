@@ -209,7 +209,7 @@ int cdl_irr_build(cdl_irr_map *im, const cdl_photon_map *global, const cdl_photo
     uint32_t k = qt->k;
     cdl_irr_free(im);
     if (every < 2)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--precompute", 0,
+        return cdl_error_set(err, CDL_ERR_USAGE, "precompute", 0,
                              "must be 0 (off) or at least 2: the photons that carry points cannot also "
                              "estimate there");
     /* A lookup takes the point nearest to where a gather ray lands, so no

@@ -21,7 +21,7 @@ enum {
 /* 32 bytes: position, flux, incoming direction (octahedral, 2 x 15 bits)
  * with two flag bits, surface normal (octahedral, 2 x 8 bits) and a tag:
  * a primary photon's light (0xffff past 65534 lights; only L_con asks),
- * any other photon's bounce count (--maxdepth counts whole paths). */
+ * any other photon's bounce count (maxdepth counts whole paths). */
 typedef struct cdl_photon {
     float p[3];
     float power[3];

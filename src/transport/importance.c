@@ -107,7 +107,7 @@ int cdl_importance_build(cdl_importance *imp, const cdl_scene *s, const cdl_came
     if (fail) {
         cdl_importance_free(imp);
         return cdl_error_set(err, fail == 2 ? CDL_ERR_INPUT : CDL_ERR_SYSTEM, "importons", 0,
-                             fail == 2 ? "too many importons (lower --importons)" : "out of memory");
+                             fail == 2 ? "too many importons (lower importons)" : "out of memory");
     }
     if (!imp->n) {
         cdl_importance_free(imp);

@@ -13,7 +13,7 @@ int cdl_light_pool_init(cdl_light_pool *lp, uint32_t k, uint32_t interleave, int
     lp->sets = lp->n_interleave * lp->n_interleave;
     lp->stride = (uint32_t)maxdepth + 2;
     if ((uint64_t)k * lp->stride > UINT32_MAX / 2)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--light-paths", 0, "too many light path vertices");
+        return cdl_error_set(err, CDL_ERR_USAGE, "light_paths", 0, "too many light path vertices");
     lp->len = calloc(k ? k : 1, sizeof(uint32_t));
     if (!lp->len)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");

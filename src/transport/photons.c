@@ -182,7 +182,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
     if (!has_emitting_light(s))
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "no light of the scene emits any power");
     if (!pp->target)
-        return cdl_error_set(err, CDL_ERR_USAGE, "--photons", 0, "must be at least 1");
+        return cdl_error_set(err, CDL_ERR_USAGE, "photons", 0, "must be at least 1");
     int specular = 0;
     for (uint32_t m = 0; m < s->nmats; m++)
         specular |= cdl_mat_is_delta(s->mats[m].type);
@@ -206,7 +206,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         if (next >= pp->max_paths) {
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                                "photon budget cannot be met: %u photons requested, %u stored after %llu "
-                               "paths (the limit, --photon-paths-max); lower --photons, or check that "
+                               "paths (the limit, photon_paths_max); lower photons, or check that "
                                "the lights reach what the camera sees",
                                pp->target, global->n, (unsigned long long)next);
             break;
@@ -256,7 +256,7 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
                                "photon budget cannot be met: no photon stored after %llu paths (do the "
                                "lights reach any surface%s?%s)",
                                (unsigned long long)next, pp->imp ? " the camera sees" : "",
-                               pp->caustic_random && cx.q < 1.0f ? " is --caustic-ratio too small?" : "");
+                               pp->caustic_random && cx.q < 1.0f ? " is caustic_ratio too small?" : "");
             break;
         }
         double need = rate > 0.0 ? (double)(pp->target - global->n) / rate : (double)next * 4.0;
@@ -264,9 +264,9 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                                "photon budget cannot be met: %u photons need about %.3g paths at the "
                                "rate so far (%.3g stored per path), more than the limit of %llu "
-                               "(--photon-paths-max); lower --photons%s",
+                               "(photon_paths_max); lower photons%s",
                                pp->target, (double)next + need, rate, (unsigned long long)pp->max_paths,
-                               pp->imp ? " or raise --importance-eps" : "");
+                               pp->imp ? " or raise importance_eps" : "");
             break;
         }
         batch = (uint64_t)(need * 1.05) + CHUNK;
@@ -277,8 +277,8 @@ int cdl_photons_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_photon
         double want = floor((double)n1 / (double)cx.q);
         if (want > (double)pp->max_paths)
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
-                               "photon budget cannot be met: --caustic-ratio %g needs %.3g paths for the "
-                               "caustic map, more than the limit of %llu (--photon-paths-max)",
+                               "photon budget cannot be met: caustic_ratio %g needs %.3g paths for the "
+                               "caustic map, more than the limit of %llu (photon_paths_max)",
                                (double)cx.q, want, (unsigned long long)pp->max_paths);
         n = rc ? n1 : (uint64_t)want;
         for (uint64_t first = n1; !rc && first < n;) {

@@ -1,0 +1,104 @@
+/* The state of the gkde integrator (Bekaert et al. 2003), shared by its
+ * two halves: gkde.c (paths, footprints, calibration, the step's image)
+ * and points.c (the eye points' kd-tree and stages 3 to 5: candidate
+ * counting, trial linking, shadow rays and scores). */
+#ifndef CDL_INTEGRATORS_GKDE_H
+#define CDL_INTEGRATORS_GKDE_H
+
+#include <string.h>
+
+#include "integrators/integrator.h"
+#include "spatial/kdparts.h"
+#include "transport/gkde_link.h"
+#include "transport/subpath.h"
+
+#define GKDE_PATHS_PER_LINK 10000 /* default: one wanted link per this many light paths */
+
+typedef struct gkde_stats {
+    double t_eye, t_light, t_count, t_link, t_rays, t_score, t_total;
+    double candidates, trials, unoccluded, points; /* summed over steps */
+    uint32_t steps;
+    size_t peak_bytes;
+} gkde_stats;
+
+typedef struct gkde_state {
+    const cdl_scene *scene;
+    cdl_options opt;
+    cdl_walk walk;
+    uint32_t n_light, eye_paths, M;
+    float h, r_cap;
+    int have_h;
+    int at_infinity; /* the scene has distant or infinite lights */
+    cdl_vertex_store lvs, evs;
+    cdl_vertex_store *chunks; /* per row (eye) or per LIGHT_CHUNK paths (light), reused */
+    uint32_t **chunk_pix;
+    uint32_t nchunks;
+    uint32_t *epix;   /* pixel of each eye vertex */
+    float *radius;    /* footprint radius of each light vertex */
+    uint32_t *lv;     /* light vertices with a footprint */
+    uint32_t nlv;
+    float *pts;       /* usable eye vertices in tree order: x, y, z, store index bits */
+    uint32_t npts;
+    cdl_kdtree kd;
+    cdl_kd_part *parts; /* the parts threads own (spatial/kdparts.h) */
+    uint32_t nparts;
+    /* per part: the candidates of stage 3 as records (light vertex list
+     * index, count, points), replayed by stage 4 without a second query */
+    struct rec_buf {
+        uint32_t *v;
+        size_t n, cap;
+        int fail;
+    } *rec;
+    uint32_t nrec;
+    /* per point */
+    uint32_t *count, *tested, *unocc;
+    uint16_t *pdepth; /* eye depth, in tree order (the candidate test reads it) */
+    double *wsum, *scale, *cum;
+    cdl_vec3 *acc;
+    cdl_gkde_eye *eye; /* what links read of each point's eye vertex */
+    /* per pixel: tested and unoccluded links, by eye depth 1, 2, 3+: pv of the
+     * steps before fold_at (the plan reads these), pv_new of the steps since.
+     * Folding at powers of two makes step i's plan a function of steps
+     * [0, 2^floor(log2 i)) alone, so processes that render disjoint steps
+     * and sum pv_new at each fold get one process's plans. */
+    uint32_t *pv, *pv_new;
+    uint32_t fold_at;
+    cdl_vec3 *pixsum;
+    size_t rec_bytes;
+    cdl_gkde_ctx g;
+    gkde_stats st;
+    atomic_int *cancel; /* the film's, set by each pass */
+} gkde_state;
+
+/* links by default: N / 10000 rounded, at least 1 (the report's M = 10
+ * at 100000 paths, 5 at the default 50000). */
+static inline uint32_t gkde_default_links(uint32_t n_light)
+{
+    uint32_t m = (n_light + GKDE_PATHS_PER_LINK / 2) / GKDE_PATHS_PER_LINK;
+    return m ? m : 1;
+}
+
+/* The eye vertex (store index) of point q. */
+static inline uint32_t gkde_point_vertex(const gkde_state *s, uint32_t q)
+{
+    uint32_t e;
+    memcpy(&e, &s->pts[4 * (size_t)q + 3], sizeof e);
+    return e;
+}
+
+/* The P_vis tally of eye vertex y: its pixel's (tested, unoccluded) pair
+ * for its depth 1, 2 or 3+. */
+static inline uint32_t gkde_pv_bucket(const gkde_state *s, uint32_t y)
+{
+    uint32_t d = s->evs.depth[y];
+    return 6 * s->epix[y] + 2 * (d >= 3 ? 2 : d - 1);
+}
+
+/* The kd-tree over the eye vertices that can be linked (points in tree
+ * order), the per-point arrays and the parts threads own. */
+int gkde_build_points(gkde_state *s, cdl_error *err);
+/* Stages 3 to 5; returns the shadow rays traced, UINT64_MAX when out of
+ * memory for the candidate records. */
+uint64_t gkde_link_all(gkde_state *s, uint32_t pass);
+
+#endif

@@ -1,0 +1,391 @@
+/* splat's radiance maps (Herzog et al. 2007, §6.1): per eye sample, the
+ * light its photon splats bring, in one of three forms:
+ *   direct     the BSDF applied per splat (exact, the cost grows with the
+ *              splats on glossy samples),
+ *   histogram  irradiance per icosahedron face of incoming directions (20
+ *              strata in world space), the BSDF applied once per stratum at
+ *              its centre at the end,
+ *   sh         the 16 spherical-harmonics coefficients of L cos in world
+ *              space (the basis evaluated once per photon ray), rotated to
+ *              the sample's frame at the end and dotted with the material's
+ *              BSDF table (eq. 6.3, 6.4).
+ * Splatting runs part by part of the eye-sample tree, each part on one
+ * thread meeting the rays in their order: the maps do not depend on the
+ * thread count. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
+#include "integrators/splat/maps.h"
+#include "integrators/splat/mask.h"
+#include "integrators/splat/occlusion.h"
+
+/* The 20 face centres of an icosahedron. */
+static void icosahedron(cdl_vec3 *c)
+{
+    const float g = 1.6180339887f;
+    cdl_vec3 v[12];
+    int n = 0;
+    for (int s1 = -1; s1 <= 1; s1 += 2)
+        for (int s2 = -1; s2 <= 1; s2 += 2) {
+            v[n++] = cdl_v3(0.0f, (float)s1, (float)s2 * g);
+            v[n++] = cdl_v3((float)s1, (float)s2 * g, 0.0f);
+            v[n++] = cdl_v3((float)s2 * g, 0.0f, (float)s1);
+        }
+    int f = 0;
+    for (int i = 0; i < 12; i++)
+        for (int j = i + 1; j < 12; j++)
+            for (int k = j + 1; k < 12; k++) {
+                cdl_vec3 a = cdl_sub(v[i], v[j]), b = cdl_sub(v[j], v[k]), d = cdl_sub(v[i], v[k]);
+                if (fabsf(cdl_dot(a, a) - 4.0f) < 1e-3f && fabsf(cdl_dot(b, b) - 4.0f) < 1e-3f &&
+                    fabsf(cdl_dot(d, d) - 4.0f) < 1e-3f && f < SPLAT_STRATA)
+                    c[f++] = cdl_normalize(cdl_add(cdl_add(v[i], v[j]), v[k]));
+            }
+}
+
+/* The glossy maps (splat_gmap_at): the histogram is stored as one image
+ * per stratum (a ray's splats all go to its stratum: neighbouring samples,
+ * neighbouring entries), SH per sample (a splat writes all 16). */
+#define gmap_at splat_gmap_at
+
+static int stratum(const splat_state *s, cdl_vec3 w)
+{
+    int best = 0;
+    float bd = -2.0f;
+    for (int i = 0; i < SPLAT_STRATA; i++) {
+        float d = cdl_dot(w, s->strata[i]);
+        if (d > bd) {
+            bd = d;
+            best = i;
+        }
+    }
+    return best;
+}
+
+int splat_maps_init(splat_state *s, cdl_error *err)
+{
+    s->K = s->opt.splat.mode == CDL_SPLAT_HISTOGRAM ? SPLAT_STRATA : s->opt.splat.mode == CDL_SPLAT_SH ? CDL_SH_N : 1;
+    icosahedron(s->strata);
+    if (s->opt.splat.mode != CDL_SPLAT_SH)
+        return 0;
+    if (cdl_sh_rot_init(&s->rot))
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "spherical-harmonics rotation is ill-conditioned");
+    const cdl_scene *sc = s->scene;
+    s->tables = malloc(sizeof *s->tables * (sc->nmats ? sc->nmats : 1));
+    if (!s->tables)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the BSDF tables");
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t m = 0; m < (int64_t)sc->nmats; m++)
+        if (!cdl_mat_is_delta(sc->mats[m].type))
+            cdl_bsdf_sh_build(&s->tables[m], &sc->mats[m]);
+    return 0;
+}
+
+int splat_maps_alloc(splat_state *s, cdl_error *err)
+{
+    size_t n = (size_t)s->nslots + 16;
+    if (!s->wsum) {
+        for (int c = 0; c < 3; c++)
+            s->E[c] = malloc(sizeof(float) * n);
+        s->wsum = malloc(sizeof(float) * n);
+        s->izsum = malloc(sizeof(float) * n);
+        s->nsum = malloc(sizeof(float) * n);
+        s->gloss = malloc(sizeof(uint32_t) * n);
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->nsum || !s->gloss)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
+    }
+    uint32_t ng = 0;
+    for (uint32_t q = 0; q < s->neye; q++)
+        s->gloss[q] = s->eye[q].b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : ng++;
+    for (uint32_t q = s->neye; q < s->neye + 16; q++)
+        s->gloss[q] = SPLAT_LAMBERT;
+    s->nglossy = ng;
+    if (ng > s->gcap || !s->gmap) {
+        free(s->gmap);
+        s->gcap = ng > s->gcap ? ng + ng / 8 : s->gcap;
+        s->gmap = malloc(sizeof(float) * 3 * s->K * (s->gcap ? s->gcap : 1));
+        if (!s->gmap)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
+    }
+    if (s->want_bw && !s->bw) {
+        s->bw = malloc(sizeof(float) * SPLAT_BW * n);
+        if (!s->bw)
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the bandwidth picture");
+    }
+    return 0;
+}
+
+size_t splat_maps_bytes(const splat_state *s)
+{
+    size_t n = s->wsum ? (size_t)s->nslots + 16 : 0;
+    return n * (6 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+           (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
+}
+
+void splat_terms_of(splat_terms *t, const splat_state *s, const cdl_photon_ray *r)
+{
+    t->r = r;
+    t->wi = cdl_neg(r->d);
+    t->ready = 1;
+    if (s->opt.splat.mode == CDL_SPLAT_SH) {
+        float y[CDL_SH_N];
+        cdl_sh_eval(t->wi, y);
+        for (int k = 0; k < CDL_SH_N; k++) {
+            t->sh[k * 3] = y[k] * r->flux.x;
+            t->sh[k * 3 + 1] = y[k] * r->flux.y;
+            t->sh[k * 3 + 2] = y[k] * r->flux.z;
+        }
+    } else if (s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) {
+        t->stratum = stratum(s, t->wi);
+    }
+}
+
+/* Glossy sample q (map entry g) takes weight w of the ray in t. */
+static void add_glossy(splat_state *s, splat_terms *t, uint32_t q, uint32_t g, float w)
+{
+    if (!t->ready)
+        splat_terms_of(t, s, t->r);
+    const int mode = s->opt.splat.mode;
+    const cdl_vec3 flux = t->r->flux;
+    if (mode == CDL_SPLAT_SH) {
+        float *mp = gmap_at(s, g, 0);
+        for (int k = 0; k < CDL_SH_N * 3; k++)
+            mp[k] += w * t->sh[k];
+    } else if (mode == CDL_SPLAT_HISTOGRAM) {
+        float *mp = gmap_at(s, g, t->stratum);
+        mp[0] += w * flux.x;
+        mp[1] += w * flux.y;
+        mp[2] += w * flux.z;
+    } else {
+        const splat_eye *ey = &s->eye[q];
+        cdl_vec3 f = cdl_bsdf_eval(&ey->b, ey->wo, t->wi, 0);
+        float *mp = gmap_at(s, g, 0);
+        mp[0] += w * f.x * flux.x;
+        mp[1] += w * f.y * flux.y;
+        mp[2] += w * f.z * flux.z;
+    }
+}
+
+void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float iz)
+{
+    const cdl_vec3 flux = t->r->flux;
+    s->E[0][q] += w * flux.x;
+    s->E[1][q] += w * flux.y;
+    s->E[2][q] += w * flux.z;
+    s->wsum[q] += w;
+    s->izsum[q] += iz;
+    s->nsum[q] += 1.0f;
+    if (s->gloss[q] != SPLAT_LAMBERT)
+        add_glossy(s, t, q, s->gloss[q], w);
+}
+
+/* The ray being splatted through one part. */
+typedef struct ray_ctx {
+    splat_state *s;
+    splat_terms t;
+    uint32_t ray;
+    uint64_t splats, masked, occluded, occl_rays;
+} ray_ctx;
+
+/* The feasible glossy samples of a batch: the ray's light in their maps. */
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w)
+{
+    for (uint32_t i = 0; i < m; i++) {
+        uint32_t q = first + i, g = c->s->gloss[q];
+        if ((mask >> i & 1u) && g != SPLAT_LAMBERT)
+            add_glossy(c->s, &c->t, q, g, w[i]);
+    }
+}
+
+/* aov bandwidth: the kernel-weighted bandwidth of the rays per sample. */
+static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
+{
+    const cdl_photon_ray *r = c->t.r;
+    for (uint32_t i = 0; i < m; i++) {
+        if (!(mask >> i & 1u))
+            continue;
+        float *b = &c->s->bw[(size_t)(first + i) * SPLAT_BW];
+        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
+        float h = r->h0 + r->dh * (z < r->len ? z : r->len);
+        int d = r->depth == 2 ? 0 : r->depth == 3 ? 1 : -1;
+        if (d >= 0) {
+            b[2 * d] += w[i] * h;
+            b[2 * d + 1] += w[i];
+        }
+        b[4] += w[i] * h;
+        b[5] += w[i];
+    }
+}
+
+/* A batch of samples from the tree: every feasible one gets the ray's
+ * irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
+ * perhaps another thread's: masked); glossy ones their map entries too. */
+static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
+{
+    ray_ctx *c = ctx;
+    splat_state *s = c->s;
+    if (s->mask) {
+        uint32_t seen = splat_mask_filter(s, c->ray, first, mask, iz);
+        c->masked += (uint64_t)__builtin_popcount(mask & ~seen);
+        if (!(mask = seen))
+            return;
+    }
+    if (s->occl) {
+        uint32_t seen = splat_occl_filter(s, c->t.r, first, mask, iz, &c->occl_rays);
+        c->occluded += (uint64_t)__builtin_popcount(mask & ~seen);
+        if (!(mask = seen))
+            return;
+    }
+    float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
+    float *ws = s->wsum + first, *zs = s->izsum + first, *ns = s->nsum + first;
+    const uint32_t *gl = s->gloss + first;
+#if defined(__AVX512F__)
+    const __mmask16 k = (__mmask16)mask;
+    const __m512 wv = _mm512_loadu_ps(w);
+    const cdl_vec3 flux = c->t.r->flux;
+    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
+    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
+    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
+    _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
+    _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
+    uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
+    c->splats += (uint64_t)__builtin_popcount(mask);
+#else
+    const float fr = c->t.r->flux.x, fg = c->t.r->flux.y, fb = c->t.r->flux.z;
+    uint32_t glossy = 0;
+    for (uint32_t i = 0; i < m; i++) {
+        if (!(mask >> i & 1u))
+            continue;
+        er[i] += w[i] * fr;
+        eg[i] += w[i] * fg;
+        eb[i] += w[i] * fb;
+        ws[i] += w[i];
+        zs[i] += iz[i];
+        ns[i] += 1.0f;
+        glossy |= gl[i] != SPLAT_LAMBERT;
+        c->splats++;
+    }
+#endif
+    if (glossy)
+        splat_glossy(c, first, m, mask, w);
+    if (s->want_bw)
+        splat_bandwidth(c, first, m, mask, w, iz);
+}
+
+void splat_maps_clear(splat_state *s)
+{
+    size_t n = (size_t)s->neye + 16;
+    for (int c = 0; c < 3; c++)
+        memset(s->E[c], 0, sizeof(float) * n);
+    memset(s->wsum, 0, sizeof(float) * n);
+    memset(s->izsum, 0, sizeof(float) * n);
+    memset(s->nsum, 0, sizeof(float) * n);
+    memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
+    if (s->want_bw)
+        memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
+}
+
+int splat_maps_splat(splat_state *s)
+{
+    splat_maps_clear(s);
+    uint64_t splats = 0, tested = 0, nodes = 0, masked = 0, occluded = 0, occl_rays = 0;
+    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
+    /* with visibility masks, a batch of rays at a time: masks first */
+    uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
+    if (s->mask && splat_mask_prepare(s))
+        return CDL_ERR_SYSTEM;
+    for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
+        uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
+        if (s->mask)
+            splat_mask_build(s, k0, k1 - k0);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, masked, occluded, occl_rays)
+        for (uint32_t part = 0; part < s->tree.nparts; part++) {
+            cdl_skd_count cnt = {0, 0};
+            ray_ctx c;
+            c.s = s;
+            c.splats = c.masked = c.occluded = c.occl_rays = 0;
+            for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
+                const cdl_photon_ray *r = &s->rays.r[k];
+                cdl_splat_ray sr = splat_ray_of(s, r);
+                c.t.r = r;
+                c.t.ready = 0;
+                c.ray = k;
+                cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
+            }
+            splats += c.splats;
+            masked += c.masked;
+            occluded += c.occluded;
+            occl_rays += c.occl_rays;
+            tested += cnt.tested;
+            nodes += cnt.nodes;
+        }
+    }
+    s->st.splats += splats;
+    s->st.masked += masked;
+    s->st.occluded += occluded;
+    s->st.occl_rays += occl_rays;
+    s->st.tested += tested;
+    s->st.nodes += nodes;
+    return 0;
+}
+
+/* The stratum's centre, moved just above the horizon of n if it lies
+ * below: the photons counted there all arrived from above. */
+static cdl_vec3 above(cdl_vec3 w, cdl_vec3 n)
+{
+    float c = cdl_dot(w, n);
+    if (c > 0.05f)
+        return w;
+    return cdl_normalize(cdl_add(w, cdl_scale(n, 0.05f - c)));
+}
+
+void splat_maps_resolve(splat_state *s)
+{
+    const int mode = s->opt.splat.mode;
+#pragma omp parallel for schedule(static)
+    for (uint32_t q = 0; q < s->neye; q++) {
+        const splat_eye *e = &s->eye[q];
+        const uint32_t g = s->gloss[q];
+        cdl_vec3 L;
+        if (g == SPLAT_LAMBERT) {
+            L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
+        } else if (mode == CDL_SPLAT_DIRECT) {
+            const float *m = gmap_at(s, g, 0);
+            L = cdl_v3(m[0], m[1], m[2]);
+        } else if (mode == CDL_SPLAT_HISTOGRAM) {
+            L = cdl_v3(0.0f, 0.0f, 0.0f);
+            for (int k = 0; k < SPLAT_STRATA; k++) {
+                const float *mk = gmap_at(s, g, k);
+                cdl_vec3 Ek = cdl_v3(mk[0], mk[1], mk[2]);
+                if (cdl_is_black(Ek))
+                    continue;
+                cdl_vec3 wi = above(s->strata[k], e->f.n);
+                L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&e->b, e->wo, wi, 0), Ek));
+            }
+        } else {
+            float loc[CDL_SH_N * 3], c[CDL_SH_N * 3];
+            cdl_sh_rotate(&s->rot, e->f, gmap_at(s, g, 0), loc, 3);
+            cdl_bsdf_sh_lookup(&s->tables[e->mat], cdl_dot(e->wo, e->f.n), e->b.kd, c);
+            float acc[3] = {0.0f, 0.0f, 0.0f};
+            for (int k = 0; k < CDL_SH_N; k++)
+                for (int ch = 0; ch < 3; ch++)
+                    acc[ch] += c[k * 3 + ch] * loc[k * 3 + ch];
+            L = cdl_v3(fmaxf(acc[0], 0.0f), fmaxf(acc[1], 0.0f), fmaxf(acc[2], 0.0f));
+        }
+        L = cdl_mul(L, e->weight);
+        /* pixels take their samples in tree order: one pixel's samples may
+         * sit in different parts, so this sum runs after the parallel loop;
+         * E holds the sample's radiance until then */
+        s->E[0][q] = L.x;
+        s->E[1][q] = L.y;
+        s->E[2][q] = L.z;
+    }
+    for (uint32_t q = 0; q < s->neye; q++) {
+        uint32_t p = s->eye[q].pixel;
+        s->pix[p] = cdl_add(s->pix[p], cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
+    }
+}

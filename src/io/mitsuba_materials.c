@@ -1,0 +1,489 @@
+/* Mitsuba bsdfs, textures and emitters as candela's materials and lights.
+ * Defaults are Mitsuba 3's; what candela has no model for is approximated
+ * with a warning (roughness distributions are all GGX, plastic is pbrt's
+ * plastic, wavelength spectra are greys). */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/mitsuba_internal.h"
+#include "io/pbrt_params.h"
+#include "scene/scene.h"
+
+/* Mitsuba's named indices of refraction (its ior.h table). */
+static const struct {
+    const char *name;
+    double ior;
+} IORS[] = {{"vacuum", 1.0},        {"helium", 1.000036},      {"hydrogen", 1.000132},   {"air", 1.000277},
+            {"carbon dioxide", 1.00045}, {"water", 1.3330},    {"acetone", 1.36},        {"ethanol", 1.361},
+            {"carbon tetrachloride", 1.461}, {"glycerol", 1.4729}, {"benzene", 1.501},   {"silicone oil", 1.52045},
+            {"bromine", 1.661},     {"water ice", 1.31},       {"fused quartz", 1.458},  {"pyrex", 1.470},
+            {"acrylic glass", 1.49}, {"polypropylene", 1.49},  {"bk7", 1.5046},          {"sodium chloride", 1.544},
+            {"amber", 1.55},        {"pet", 1.5750},           {"diamond", 2.419}};
+
+static int ior_prop(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, double def, double *out)
+{
+    cdl_xml_node *p = cdl_mts_prop(c, n, name);
+    *out = def;
+    if (!p)
+        return 0;
+    p->used = 0; /* read again as a float or a string */
+    if (!strcmp(p->name, "string")) {
+        char s[64];
+        int rc = cdl_mts_string(c, n, name, NULL, s, sizeof s);
+        if (rc)
+            return rc;
+        for (size_t i = 0; i < sizeof IORS / sizeof IORS[0]; i++)
+            if (!strcmp(s, IORS[i].name)) {
+                *out = IORS[i].ior;
+                return 0;
+            }
+        return cdl_mts_error(c, p->line, "%s \"%s\" is not a known material (give a number)", name, s);
+    }
+    int rc = cdl_mts_float(c, n, name, def, out);
+    if (!rc && !(*out > 0.0 && *out < 100.0))
+        rc = cdl_mts_error(c, p->line, "%s %g must be in (0, 100)", name, *out);
+    return rc;
+}
+
+/* A color property that may be a texture (tex != NULL) or must be constant. */
+static int color(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex)
+{
+    cdl_xml_node *p = cdl_mts_prop(c, n, name);
+    *out = def;
+    if (tex)
+        *tex = -1;
+    if (!p)
+        return 0;
+    int t = -1, rc = 0;
+    cdl_vec3 v = def;
+    if (!strcmp(p->name, "ref")) {
+        int rc2 = 0;
+        const char *id = cdl_mts_attr(c, p, "id", &rc2);
+        if (rc2)
+            return rc2;
+        const cdl_mts_id *d = id ? cdl_mts_find_id(c, id) : NULL;
+        if (!d)
+            return cdl_mts_error(c, p->line, "%s: <ref id=\"%s\"> is not declared before", name, id ? id : "");
+        if (d->kind != CDL_MTS_TEXTURE)
+            return cdl_mts_error(c, p->line, "%s: \"%s\" is not a texture", name, id);
+        t = d->tex;
+        v = d->value;
+    } else if (!strcmp(p->name, "texture")) {
+        rc = cdl_mts_texture(c, p, &t, &v);
+    } else {
+        rc = cdl_mts_color_node(c, p, &v);
+    }
+    if (rc)
+        return rc;
+    if (!cdl_is_finite3(v) || v.x < 0.0f || v.y < 0.0f || v.z < 0.0f)
+        return cdl_mts_error(c, p->line, "%s (%g, %g, %g) must be finite and >= 0", name, (double)v.x, (double)v.y,
+                             (double)v.z);
+    if (t >= 0 && !tex) {
+        cdl_mts_warn(c, p->line, "%s: a texture is supported only for reflectances here; its scale is used", name);
+        t = -1;
+    }
+    *out = v;
+    if (tex)
+        *tex = t;
+    return 0;
+}
+
+/* Reflectances above 1 create energy: clamped, with a warning. */
+static cdl_vec3 at_most_one(cdl_mts_ctx *c, int line, const char *what, cdl_vec3 v)
+{
+    if (v.x > 1.0f || v.y > 1.0f || v.z > 1.0f) {
+        cdl_mts_warn(c, line, "%s (%g, %g, %g) reflects more than all light: clamped to 1", what, (double)v.x,
+                     (double)v.y, (double)v.z);
+        v = cdl_v3(fminf(v.x, 1.0f), fminf(v.y, 1.0f), fminf(v.z, 1.0f));
+    }
+    return v;
+}
+
+/* alpha, alpha_u, alpha_v and distribution of the rough models. */
+static int roughness(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m)
+{
+    double a, au, av;
+    char dist[32];
+    int rc;
+    if ((rc = cdl_mts_float(c, n, "alpha", rough ? 0.1 : 0.0, &a)) ||
+        (rc = cdl_mts_float(c, n, "alpha_u", a, &au)) || (rc = cdl_mts_float(c, n, "alpha_v", a, &av)) ||
+        (rc = cdl_mts_string(c, n, "distribution", "beckmann", dist, sizeof dist)))
+        return rc;
+    if (!(au >= 0.0 && av >= 0.0 && au <= 10.0 && av <= 10.0))
+        return cdl_mts_error(c, n->line, "alpha (%g, %g) must be in [0, 10]", au, av);
+    if (rough && strcmp(dist, "ggx") && strcmp(dist, "beckmann") && strcmp(dist, "phong"))
+        return cdl_mts_error(c, n->line, "distribution \"%s\" must be ggx, beckmann or phong", dist);
+    cdl_mts_prop(c, n, "sample_visible");
+    m->alpha_x = (float)au;
+    m->alpha_y = (float)av;
+    return 0;
+}
+
+/* int_ior / ext_ior as one relative index. */
+static int rel_ior(cdl_mts_ctx *c, cdl_xml_node *n, double int_def, float *eta)
+{
+    double in, ext;
+    int rc;
+    if ((rc = ior_prop(c, n, "int_ior", int_def, &in)) || (rc = ior_prop(c, n, "ext_ior", 1.000277, &ext)))
+        return rc;
+    *eta = (float)(in / ext);
+    return 0;
+}
+
+int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat, int *found)
+{
+    *found = 0;
+    for (int i = 0; i < n->nkids; i++) {
+        cdl_xml_node *k = &n->kids[i];
+        if (!strcmp(k->name, "bsdf")) {
+            k->used = 1;
+            *found = 1;
+            return cdl_mts_bsdf(c, k, mat);
+        }
+        if (!strcmp(k->name, "ref")) {
+            int rc = 0;
+            const char *id = cdl_mts_attr(c, k, "id", &rc);
+            if (rc)
+                return rc;
+            const cdl_mts_id *d = id ? cdl_mts_find_id(c, id) : NULL;
+            if (strict && !d)
+                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> is not declared before", id ? id : "");
+            if (strict && d->kind != CDL_MTS_BSDF)
+                return cdl_mts_error(c, k->line, "<ref id=\"%s\"> in a shape must name a bsdf", id);
+            if (!d || d->kind != CDL_MTS_BSDF)
+                continue; /* a texture reference of a wrapper */
+            k->used = 1;
+            *found = 1;
+            *mat = d->mat;
+            return 0;
+        }
+    }
+    return 0;
+}
+
+int cdl_mts_default_material(cdl_mts_ctx *c, int32_t *mat)
+{
+    if (c->default_mat < 0) {
+        cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
+        uint32_t id;
+        snprintf(m.name, sizeof m.name, "mitsuba-default");
+        int rc = cdl_scene_add_material(c->s, &m, &id, c->err);
+        if (rc)
+            return rc;
+        c->default_mat = (int32_t)id;
+    }
+    *mat = c->default_mat;
+    return 0;
+}
+
+static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m)
+{
+    char metal[32];
+    int rc;
+    *m = cdl_material_default(CDL_MAT_CONDUCTOR);
+    if ((rc = cdl_mts_string(c, n, "material", "none", metal, sizeof metal)))
+        return rc;
+    if (!strcmp(metal, "none")) { /* a perfect mirror: Fresnel 1 at every angle */
+        m->eta3 = cdl_v3(0, 0, 0);
+        m->k3 = cdl_v3(1, 1, 1);
+    } else {
+        char ne[48], nk[48];
+        snprintf(ne, sizeof ne, "metal-%s-eta", metal);
+        snprintf(nk, sizeof nk, "metal-%s-k", metal);
+        int r1 = cdl_pbrt_named_spectrum(ne, &m->eta3), r2 = cdl_pbrt_named_spectrum(nk, &m->k3);
+        if (r1 < 0 || r2 < 0 || r1 == 1) {
+            cdl_mts_warn(c, n->line, "conductor material \"%s\" is not in candela's table: copper is used", metal);
+            cdl_pbrt_named_spectrum("metal-Cu-eta", &m->eta3);
+            cdl_pbrt_named_spectrum("metal-Cu-k", &m->k3);
+        }
+    }
+    if ((rc = color(c, n, "eta", m->eta3, &m->eta3, NULL)) || (rc = color(c, n, "k", m->k3, &m->k3, NULL)) ||
+        (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
+        (rc = roughness(c, n, rough, m)))
+        return rc;
+    m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
+    return 0;
+}
+
+int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    char type[64];
+    int rc = cdl_mts_type(c, n, type, sizeof type), found;
+    if (rc)
+        return rc;
+    n->used = 1;
+    /* wrappers: the surface is the nested bsdf's */
+    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "mask", "blendbsdf", "coating",
+                                       "roughcoating"};
+    for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
+        if (!strcmp(type, wrap[i])) {
+            if ((rc = cdl_mts_child_bsdf(c, n, 0, mat, &found)))
+                return rc;
+            if (!found)
+                return cdl_mts_error(c, n->line, "bsdf \"%s\" needs a nested <bsdf> or <ref>", type);
+            if (i > 0) {
+                cdl_mts_warn(c, n->line, "bsdf \"%s\": only its (first) nested bsdf is rendered", type);
+                for (int k = 0; k < n->nkids; k++)
+                    n->kids[k].used = 1;
+            }
+            cdl_mts_warn_unused(c, n, type);
+            return 0;
+        }
+    cdl_material m;
+    int rough = !strncmp(type, "rough", 5);
+    if (!strcmp(type, "diffuse") || !strcmp(type, "roughdiffuse")) {
+        m = cdl_material_default(CDL_MAT_DIFFUSE);
+        rc = color(c, n, "reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
+        if (!rc && type[0] == 'r') {
+            cdl_mts_warn(c, n->line, "bsdf \"roughdiffuse\": Oren-Nayar approximated by Lambert");
+            cdl_mts_prop(c, n, "alpha");
+            cdl_mts_prop(c, n, "use_fast_approx");
+        }
+    } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
+        m = cdl_material_default(CDL_MAT_PLASTIC);
+        int nonlinear;
+        if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
+            !(rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
+            !(rc = rel_ior(c, n, 1.49, &m.eta)) && !(rc = roughness(c, n, rough, &m)))
+            rc = cdl_mts_bool(c, n, "nonlinear", 0, &nonlinear);
+        m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
+    } else if (!strcmp(type, "conductor") || !strcmp(type, "roughconductor")) {
+        rc = conductor(c, n, rough, &m);
+    } else if (!strcmp(type, "dielectric") || !strcmp(type, "roughdielectric") || !strcmp(type, "thindielectric")) {
+        m = cdl_material_default(rough ? CDL_MAT_ROUGH_DIELECTRIC : CDL_MAT_DIELECTRIC);
+        if (type[0] == 't')
+            cdl_mts_warn(c, n->line, "bsdf \"thindielectric\": rendered as a dielectric interface");
+        if (!(rc = rel_ior(c, n, 1.5046, &m.eta)) &&
+            !(rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
+            !(rc = color(c, n, "specular_transmittance", cdl_v3(1, 1, 1), &m.kt, NULL)))
+            rc = roughness(c, n, rough, &m);
+        m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
+        m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
+    } else if (!strcmp(type, "phong")) {
+        double e = 30.0;
+        m = cdl_material_default(CDL_MAT_PHONG);
+        if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
+            !(rc = color(c, n, "specular_reflectance", cdl_v3(0.2f, 0.2f, 0.2f), &m.ks, NULL)) &&
+            !(rc = cdl_mts_float(c, n, "exponent", 30.0, &e)) && !(e >= 0.0 && e <= 1e6))
+            rc = cdl_mts_error(c, n->line, "phong exponent %g must be in [0, 1e6]", e);
+        m.ns = (float)e;
+        float sc = cdl_phong_energy_scale(&m);
+        if (!rc && sc < 1.0f) {
+            cdl_mts_warn(c, n->line, "phong: diffuse + specular reflect more than all light; scaled by %.3f",
+                         (double)sc);
+            m.kd = cdl_scale(m.kd, sc);
+            m.ks = cdl_scale(m.ks, sc);
+        }
+    } else if (!strcmp(type, "null")) {
+        cdl_mts_warn_unused(c, n, "bsdf \"null\"");
+        *mat = -1;
+        return 0;
+    } else {
+        cdl_mts_warn(c, n->line, "bsdf \"%s\" is not supported: rendered as diffuse", type);
+        m = cdl_material_default(CDL_MAT_DIFFUSE);
+        /* the base colour under its usual names (principled: base_color) */
+        cdl_xml_node *p = cdl_mts_prop(c, n, "reflectance");
+        if (!p)
+            p = cdl_mts_prop(c, n, "diffuse_reflectance");
+        if (!p)
+            p = cdl_mts_prop(c, n, "base_color");
+        if (p)
+            p->used = 0;
+        if (p && color(c, n, cdl_xml_attr_get(p, "name"), m.kd, &m.kd, &m.kd_tex))
+            return CDL_ERR_INPUT;
+        for (int k = 0; k < n->nkids; k++)
+            n->kids[k].used = 1;
+    }
+    if (rc)
+        return rc;
+    if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_PLASTIC || m.type == CDL_MAT_PHONG)
+        m.kd = at_most_one(c, n->line, "diffuse reflectance", m.kd);
+    const char *id = cdl_xml_attr_get(n, "id");
+    snprintf(m.name, sizeof m.name, "%.63s", id ? id : type);
+    cdl_mts_warn_unused(c, n, type);
+    uint32_t idx;
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+        return rc;
+    *mat = (int32_t)idx;
+    return 0;
+}
+
+int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value)
+{
+    char type[64];
+    int rc = cdl_mts_type(c, n, type, sizeof type);
+    if (rc)
+        return rc;
+    n->used = 1;
+    *tex = -1;
+    *value = cdl_v3(1, 1, 1);
+    if (!strcmp(type, "bitmap")) {
+        char fn[1024], path[1024];
+        if ((rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn)))
+            return rc;
+        if (!fn[0])
+            return cdl_mts_error(c, n->line, "texture \"bitmap\" needs a \"filename\"");
+        if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)) ||
+            (rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_texture(c->s, path, tex, c->err))))
+            return rc;
+        /* sampling details: candela filters bilinearly and repeats */
+        static const char *const fine[] = {"filter_type", "wrap_mode", "raw", "gamma", "cache", "max_anisotropy",
+                                           "format", "channel"};
+        for (size_t i = 0; i < sizeof fine / sizeof fine[0]; i++)
+            cdl_mts_prop(c, n, fine[i]);
+        static const char *const uvs[] = {"to_uv", "uscale", "vscale", "uoffset", "voffset"};
+        for (size_t i = 0; i < sizeof uvs / sizeof uvs[0]; i++)
+            if (cdl_mts_prop(c, n, uvs[i]))
+                cdl_mts_warn(c, n->line, "texture \"bitmap\": %s ignored (uv used as given)", uvs[i]);
+    } else if (!strcmp(type, "checkerboard")) {
+        cdl_vec3 a, b;
+        if ((rc = color(c, n, "color0", cdl_v3(0.4f, 0.4f, 0.4f), &a, NULL)) ||
+            (rc = color(c, n, "color1", cdl_v3(0.2f, 0.2f, 0.2f), &b, NULL)))
+            return rc;
+        cdl_mts_warn(c, n->line, "texture \"checkerboard\": rendered as the mean of its colors");
+        *value = cdl_scale(cdl_add(a, b), 0.5f);
+        cdl_mts_prop(c, n, "to_uv");
+    } else {
+        cdl_mts_warn(c, n->line, "texture \"%s\" is not supported: a constant 0.5", type);
+        *value = cdl_v3(0.5f, 0.5f, 0.5f);
+        for (int k = 0; k < n->nkids; k++)
+            n->kids[k].used = 1;
+    }
+    cdl_mts_warn_unused(c, n, type);
+    return 0;
+}
+
+static int check_emission(cdl_mts_ctx *c, int line, const char *what, cdl_vec3 v)
+{
+    if (!cdl_is_finite3(v) || v.x < 0.0f || v.y < 0.0f || v.z < 0.0f || cdl_max3(v) > 1e12f)
+        return cdl_mts_error(c, line, "%s (%g, %g, %g) must be finite, >= 0 and <= 1e12", what, (double)v.x,
+                             (double)v.y, (double)v.z);
+    return 0;
+}
+
+int cdl_mts_area(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *emit)
+{
+    char type[64];
+    cdl_vec3 L;
+    int rc = cdl_mts_type(c, n, type, sizeof type);
+    if (rc)
+        return rc;
+    n->used = 1;
+    if (strcmp(type, "area"))
+        return cdl_mts_error(c, n->line, "emitter \"%s\" inside a <shape>: only \"area\" belongs there", type);
+    if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &L, NULL)) ||
+        (rc = check_emission(c, n->line, "area radiance", L)))
+        return rc;
+    cdl_mts_prop(c, n, "sampling_weight");
+    cdl_mts_warn_unused(c, n, "emitter \"area\"");
+    /* Mitsuba's area emitters shine from the front face only */
+    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_emitter(c->s, L, 0, emit, c->err));
+}
+
+static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
+{
+    char fn[1024], path[1024];
+    double scale;
+    int rc;
+    if ((rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn)) ||
+        (rc = cdl_mts_float(c, n, "scale", 1.0, &scale)))
+        return rc;
+    if (!fn[0])
+        return cdl_mts_error(c, n->line, "emitter \"envmap\" needs a \"filename\"");
+    if (!(scale >= 0.0 && scale <= 1e12))
+        return cdl_mts_error(c, n->line, "envmap scale %g must be in [0, 1e12]", scale);
+    if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
+        return rc;
+    cdl_mts_prop(c, n, "gamma");
+    cdl_mts_prop(c, n, "cache");
+    cdl_mts_prop(c, n, "filter_type");
+    /* Mitsuba's map is y-up with u = atan2(x, -z) / 2 pi: pbrt-v3's z-up
+     * frame with x' = -z, y' = x, z' = y */
+    cdl_vec3 frame[3] = {cdl_scale(cdl_mat4_vector3(m, cdl_v3(0, 0, 1)), -1.0f), cdl_mat4_vector3(m, cdl_v3(1, 0, 0)),
+                         cdl_mat4_vector3(m, cdl_v3(0, 1, 0))};
+    cdl_envmap *em = malloc(sizeof *em);
+    if (!em)
+        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, n->line, "out of memory");
+    float s = (float)scale;
+    if ((rc = cdl_envmap_load(em, path, cdl_v3(s, s, s), frame, 0, c->err))) {
+        free(em);
+        return rc;
+    }
+    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_env_light(c->s, cdl_v3(1, 1, 1), em, c->err));
+}
+
+int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
+{
+    char type[64];
+    int rc = cdl_mts_type(c, n, type, sizeof type), found;
+    if (rc)
+        return rc;
+    n->used = 1;
+    cdl_mat4 m;
+    cdl_vec3 v, p, d;
+    if ((rc = cdl_mts_transform(c, n, "to_world", &m)))
+        return rc;
+    cdl_mts_prop(c, n, "sampling_weight");
+    if (!strcmp(type, "area"))
+        return cdl_mts_error(c, n->line, "emitter \"area\" must be inside a <shape>");
+    if (!strcmp(type, "point")) {
+        if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &v, NULL)) ||
+            (rc = check_emission(c, n->line, "point intensity", v)) ||
+            (rc = cdl_mts_vec(c, n, "position", cdl_mat4_point3(&m, cdl_v3(0, 0, 0)), &p, NULL)))
+            return rc;
+        cdl_mts_warn_unused(c, n, "emitter \"point\"");
+        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_point_light(c->s, p, v, c->err));
+    }
+    if (!strcmp(type, "spot")) {
+        double cut, beam;
+        if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &v, NULL)) ||
+            (rc = check_emission(c, n->line, "spot intensity", v)) ||
+            (rc = cdl_mts_float(c, n, "cutoff_angle", 20.0, &cut)) ||
+            (rc = cdl_mts_float(c, n, "beam_width", cut * 0.75, &beam)))
+            return rc;
+        if (!(cut > 0.0 && cut <= 90.0))
+            return cdl_mts_error(c, n->line, "spot cutoff_angle %g must be in (0, 90] degrees", cut);
+        if (!(beam >= 0.0 && beam <= cut))
+            return cdl_mts_error(c, n->line, "spot beam_width %g must be in [0, cutoff_angle = %g]", beam, cut);
+        if (cdl_mts_prop(c, n, "texture"))
+            cdl_mts_warn(c, n->line, "spot texture ignored");
+        p = cdl_mat4_point3(&m, cdl_v3(0, 0, 0));
+        d = cdl_mat4_vector3(&m, cdl_v3(0, 0, 1));
+        if (!(cdl_length(d) > 0.0f))
+            return cdl_mts_error(c, n->line, "spot to_world is singular");
+        cdl_mts_warn_unused(c, n, "emitter \"spot\"");
+        /* Mitsuba's falloff runs from beam_width to cutoff_angle, pbrt's over conedelta */
+        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_spot_light(c->s, p, d, v, (float)cut, (float)(cut - beam),
+                                                                     c->err));
+    }
+    if (!strcmp(type, "directional")) {
+        if ((rc = color(c, n, "irradiance", cdl_v3(1, 1, 1), &v, NULL)) ||
+            (rc = check_emission(c, n->line, "directional irradiance", v)) ||
+            (rc = cdl_mts_vec(c, n, "direction", cdl_mat4_vector3(&m, cdl_v3(0, 0, 1)), &d, &found)))
+            return rc;
+        if (!(cdl_length(d) > 0.0f))
+            return cdl_mts_error(c, n->line, "directional: the direction is zero");
+        cdl_mts_warn_unused(c, n, "emitter \"directional\"");
+        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_distant_light(c->s, d, v, c->err));
+    }
+    if (!strcmp(type, "constant")) {
+        if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &v, NULL)) ||
+            (rc = check_emission(c, n->line, "constant radiance", v)))
+            return rc;
+        cdl_mts_warn_unused(c, n, "emitter \"constant\"");
+        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_infinite_light(c->s, v, c->err));
+    }
+    if (!strcmp(type, "envmap")) {
+        if ((rc = envmap(c, n, &m)))
+            return rc;
+        cdl_mts_warn_unused(c, n, "emitter \"envmap\"");
+        return 0;
+    }
+    cdl_mts_warn(c, n->line, "emitter \"%s\" is not supported (ignored)", type);
+    for (int k = 0; k < n->nkids; k++)
+        n->kids[k].used = 1;
+    return 0;
+}

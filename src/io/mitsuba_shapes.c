@@ -1,0 +1,232 @@
+/* Mitsuba shapes: meshes from OBJ, PLY and serialized files, the built-in
+ * rectangle, cube, disk and sphere, each with its bsdf and area emitter.
+ * Orientation is Mitsuba's: a triangle faces its shading normals when the
+ * mesh has them, else its counter-clockwise normal after the transform
+ * (Mitsuba does not flip faces under mirroring transforms, unlike pbrt);
+ * flip_normals turns both. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/mesh.h"
+#include "io/mitsuba_internal.h"
+#include "io/obj_loader.h"
+#include "io/ply.h"
+#include "io/serialized.h"
+
+#define PI 3.14159265358979323846
+#define DISK_SEGMENTS 128
+
+/* Mitsuba 3's rectangle: [-1, 1]^2 at z = 0, facing +z. */
+static int rectangle(cdl_mts_ctx *c, int line, cdl_mesh *m)
+{
+    static const float p[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    static const uint32_t idx[6] = {0, 1, 2, 2, 3, 0};
+    int rc = cdl_mesh_alloc(m, 4, 2, 1, 1, c->file, line, c->err);
+    if (rc)
+        return rc;
+    memcpy(m->pos, p, sizeof p);
+    memcpy(m->uv, uv, sizeof uv);
+    memcpy(m->idx, idx, sizeof idx);
+    for (int i = 0; i < 4; i++)
+        m->nrm[3 * i] = 0.0f, m->nrm[3 * i + 1] = 0.0f, m->nrm[3 * i + 2] = 1.0f;
+    return 0;
+}
+
+/* [-1, 1]^3, four vertices per face with the face's outward normal. */
+static int cube(cdl_mts_ctx *c, int line, cdl_mesh *m)
+{
+    int rc = cdl_mesh_alloc(m, 24, 12, 1, 1, c->file, line, c->err);
+    if (rc)
+        return rc;
+    for (int f = 0; f < 6; f++) {
+        int axis = f / 2;
+        float s = f % 2 ? 1.0f : -1.0f;
+        /* u, v axes with cross(u, v) = s * e_axis, so the corners run counter-clockwise seen from outside */
+        int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+        for (int k = 0; k < 4; k++) {
+            float cu = (k == 1 || k == 2) ? 1.0f : -1.0f, cv = k >= 2 ? 1.0f : -1.0f;
+            float *pp = m->pos + 3 * (4 * f + k), *nn = m->nrm + 3 * (4 * f + k);
+            pp[axis] = s;
+            pp[ua] = s > 0 ? cu : cv;
+            pp[va] = s > 0 ? cv : cu;
+            nn[0] = nn[1] = nn[2] = 0.0f;
+            nn[axis] = s;
+            m->uv[2 * (4 * f + k)] = 0.5f * (cu + 1.0f);
+            m->uv[2 * (4 * f + k) + 1] = 0.5f * (cv + 1.0f);
+        }
+        uint32_t b = (uint32_t)(4 * f), *t = m->idx + 6 * f;
+        t[0] = b, t[1] = b + 1, t[2] = b + 2, t[3] = b + 2, t[4] = b + 3, t[5] = b;
+    }
+    return 0;
+}
+
+/* The unit disk at z = 0 facing +z, as a fan. */
+static int disk(cdl_mts_ctx *c, int line, cdl_mesh *m)
+{
+    const int n = DISK_SEGMENTS;
+    int rc = cdl_mesh_alloc(m, (uint32_t)n + 1, (uint32_t)n, 1, 1, c->file, line, c->err);
+    if (rc)
+        return rc;
+    for (int i = 0; i <= n; i++) {
+        double a = 2.0 * PI * i / n;
+        float *pp = m->pos + 3 * i, *nn = m->nrm + 3 * i;
+        pp[0] = i == n ? 0.0f : (float)cos(a);
+        pp[1] = i == n ? 0.0f : (float)sin(a);
+        pp[2] = 0.0f;
+        nn[0] = nn[1] = 0.0f;
+        nn[2] = 1.0f;
+        m->uv[2 * i] = i == n ? 0.0f : (float)i / (float)n; /* Mitsuba's (phi / 2 pi, r) */
+        m->uv[2 * i + 1] = i == n ? 0.0f : 1.0f;
+    }
+    for (int i = 0; i < n; i++) {
+        m->idx[3 * i] = (uint32_t)n;
+        m->idx[3 * i + 1] = (uint32_t)i;
+        m->idx[3 * i + 2] = (uint32_t)((i + 1) % n);
+    }
+    return 0;
+}
+
+static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh *m)
+{
+    char fn[1024], path[1024];
+    int rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn);
+    if (rc)
+        return rc;
+    if (!fn[0])
+        return cdl_mts_error(c, n->line, "shape \"%s\" needs a \"filename\"", type);
+    if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
+        return rc;
+    if (!strcmp(type, "obj")) {
+        int flip_uv;
+        /* Mitsuba flips an OBJ's v by default: that is candela's convention;
+         * flip_tex_coords false keeps the file's v, so candela flips it */
+        if ((rc = cdl_mts_bool(c, n, "flip_tex_coords", 1, &flip_uv)) || (rc = cdl_obj_read_mesh(path, m, c->err)))
+            return rc;
+        for (uint32_t i = 0; !flip_uv && m->uv && i < m->nverts; i++)
+            m->uv[2 * i + 1] = 1.0f - m->uv[2 * i + 1];
+    } else if (!strcmp(type, "ply")) {
+        rc = cdl_ply_read(path, m, c->err);
+    } else {
+        long index;
+        if ((rc = cdl_mts_int(c, n, "shape_index", 0, &index)))
+            return rc;
+        if (index < 0 || index > 1000000000L)
+            return cdl_mts_error(c, n->line, "shape_index %ld must be >= 0", index);
+        /* uvs as stored: Sponza's serialized meshes and its OBJ agree with them unflipped */
+        rc = cdl_serialized_read(path, (uint32_t)index, m, c->err);
+    }
+    if (rc)
+        return rc;
+    int face;
+    if ((rc = cdl_mts_bool(c, n, "face_normals", 0, &face)))
+        return rc;
+    if (face && m->nrm) {
+        free(m->nrm);
+        m->nrm = NULL;
+    }
+    return 0;
+}
+
+/* The shape's surface: a nested <bsdf>, a <ref> to one, or Mitsuba's default. */
+static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    int found, rc = cdl_mts_child_bsdf(c, n, 1, mat, &found);
+    return rc || found ? rc : cdl_mts_default_material(c, mat);
+}
+
+int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
+{
+    char type[64];
+    int rc = cdl_mts_type(c, n, type, sizeof type), flip;
+    if (rc)
+        return rc;
+    n->used = 1;
+    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere"};
+    size_t kind = 0;
+    while (kind < sizeof known / sizeof known[0] && strcmp(type, known[kind]))
+        kind++;
+    if (kind == sizeof known / sizeof known[0]) {
+        cdl_mts_warn(c, n->line, "shape \"%s\" is not supported (skipped)", type);
+        for (int k = 0; k < n->nkids; k++)
+            n->kids[k].used = 1;
+        return 0;
+    }
+    cdl_mat4 m;
+    int32_t mat, emit = -1;
+    if ((rc = cdl_mts_transform(c, n, "to_world", &m)) || (rc = cdl_mts_bool(c, n, "flip_normals", 0, &flip)) ||
+        (rc = shape_bsdf(c, n, &mat)))
+        return rc;
+    for (int i = 0; i < n->nkids && !rc; i++)
+        if (!strcmp(n->kids[i].name, "emitter")) {
+            if (emit >= 0)
+                return cdl_mts_error(c, n->kids[i].line, "a shape has one area emitter");
+            rc = cdl_mts_area(c, &n->kids[i], &emit);
+        }
+    if (rc)
+        return rc;
+    if (mat < 0) { /* a null bsdf: only an emitter's surface is worth keeping */
+        if (emit < 0) {
+            cdl_mts_warn(c, n->line, "shape with a \"null\" bsdf and no emitter skipped");
+            cdl_mts_warn_unused(c, n, type);
+            return 0;
+        }
+        cdl_material black = cdl_material_default(CDL_MAT_DIFFUSE);
+        black.kd = cdl_v3(0, 0, 0);
+        snprintf(black.name, sizeof black.name, "null");
+        uint32_t id;
+        if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &black, &id, c->err))))
+            return rc;
+        mat = (int32_t)id;
+    }
+    c->nshapes++;
+    if (!strcmp(type, "sphere")) {
+        double r, scale;
+        cdl_vec3 ctr;
+        if ((rc = cdl_mts_float(c, n, "radius", 1.0, &r)) ||
+            (rc = cdl_mts_vec(c, n, "center", cdl_v3(0, 0, 0), &ctr, NULL)))
+            return rc;
+        if (!(r > 0.0 && r <= CDL_MAX_COORD))
+            return cdl_mts_error(c, n->line, "sphere radius %g must be > 0", r);
+        cdl_mat4 t = cdl_mat4_translate(ctr.x, ctr.y, ctr.z), full = cdl_mat4_mul(&m, &t);
+        cdl_mts_warn_unused(c, n, "shape \"sphere\"");
+        if (cdl_mat4_is_similarity(&full, 1e-4, &scale)) {
+            cdl_vec3 w = cdl_mat4_point3(&full, cdl_v3(0, 0, 0));
+            return cdl_mts_scene_rc(c, n->line, cdl_scene_add_sphere(c->s, w, (float)(r * scale), (uint32_t)mat, emit,
+                                                                     flip, c->err));
+        }
+        cdl_mesh sm;
+        if (!(rc = cdl_mesh_sphere(&sm, r, flip, c->file, n->line, c->err)))
+            rc = cdl_scene_add_mesh(c->s, &sm, &full, 0, (uint32_t)mat, emit, c->file, n->line, c->err);
+        cdl_mesh_free(&sm);
+        return rc;
+    }
+    cdl_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    if (kind <= 2)
+        rc = mesh_file(c, n, type, &mesh);
+    else if (!strcmp(type, "rectangle"))
+        rc = rectangle(c, n->line, &mesh);
+    else if (!strcmp(type, "cube"))
+        rc = cube(c, n->line, &mesh);
+    else
+        rc = disk(c, n->line, &mesh);
+    if (!rc) {
+        if (flip && mesh.nrm)
+            for (size_t i = 0; i < 3 * (size_t)mesh.nverts; i++)
+                mesh.nrm[i] = -mesh.nrm[i];
+        /* cdl_scene_add_mesh flips mirrored meshes without normals (pbrt's
+         * rule); cancel that, Mitsuba keeps the transformed winding */
+        int reverse = flip ^ cdl_mat4_swaps_handedness(&m);
+        static const char *const quiet[] = {"filename", "shape_index", "face_normals"};
+        for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++)
+            cdl_mts_prop(c, n, quiet[i]);
+        cdl_mts_warn_unused(c, n, type);
+        rc = cdl_scene_add_mesh(c->s, &mesh, &m, reverse, (uint32_t)mat, emit, c->file, n->line, c->err);
+    }
+    cdl_mesh_free(&mesh);
+    return rc;
+}

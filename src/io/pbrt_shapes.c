@@ -1,0 +1,267 @@
+/* pbrt shapes: triangle, bilinear-patch and PLY meshes, spheres (analytic
+ * under similarity transforms, tessellated otherwise), and flattened object
+ * instances. Orientation follows pbrt-v3 exactly, since area lights emit
+ * from the front face only: a triangle's normal is cross(p0 - p2, p1 - p2)
+ * (= the CCW normal), turned towards the shading normals when the mesh has
+ * N (FaceForward), else flipped by ReverseOrientation XOR a handedness-
+ * swapping transform. We store every triangle with its pbrt normal as CCW. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+#include "scene/mesh.h"
+#include "io/ply.h"
+
+
+void cdl_pbrt_shape_free(cdl_pbrt_shape *sh)
+{
+    cdl_mesh_free(&sh->mesh);
+    memset(sh, 0, sizeof *sh);
+}
+
+static int oom(cdl_pbrt_ctx *c)
+{
+    return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
+}
+
+/* trianglemesh (quads = 0) or pbrt-v4 bilinearmesh (quads = 1, split
+ * into two triangles (p00, p10, p11), (p00, p11, p01) that keep the
+ * patch's normal cross(dp/du, dp/dv)). */
+static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_mesh *m)
+{
+    cdl_pbrt_params *ps = &c->ps;
+    const char *what = quads ? "bilinearmesh" : "trianglemesh";
+    size_t per = quads ? 4 : 3;
+    cdl_pbrt_param *P = cdl_pbrt_find(ps, "P"), *I = cdl_pbrt_find(ps, "indices");
+    cdl_pbrt_param *N = cdl_pbrt_find(ps, "N"), *UV = cdl_pbrt_find(ps, "uv");
+    if (!UV)
+        UV = cdl_pbrt_find(ps, "st"); /* pbrt-v3's other name */
+    cdl_pbrt_find(ps, "S");           /* tangents: shading frames are built from N */
+    cdl_pbrt_find(ps, "faceIndices");
+    if (!P)
+        return cdl_pbrt_error(c, c->line, "%s needs \"point3 P\"", what);
+    if (P->type != CDL_PT_POINT3)
+        return cdl_pbrt_error(c, P->line, "%s: P must be point3, not %s", what, P->tname);
+    if (P->n == 0 || P->n / 3 >= UINT32_MAX / 4)
+        return cdl_pbrt_error(c, P->line, "%s: P has %zu points", what, P->n / 3);
+    uint32_t nv = (uint32_t)(P->n / 3);
+    static const double def4[4] = {0, 1, 2, 3};
+    const double *iv = def4;
+    size_t ni = per;
+    if (I) {
+        if (I->type != CDL_PT_INT)
+            return cdl_pbrt_error(c, I->line, "%s: indices must be integer, not %s", what, I->tname);
+        iv = cdl_pbrt_nums(ps, I);
+        ni = I->n;
+    } else if (nv != per) {
+        return cdl_pbrt_error(c, c->line, "%s needs \"integer indices\" (it has %u points)", what, nv);
+    }
+    if (ni == 0 || ni % per)
+        return cdl_pbrt_error(c, I ? I->line : c->line, "%s: %zu indices is not a multiple of %zu", what,
+                              ni, per);
+    for (size_t i = 0; i < ni; i++)
+        if (iv[i] < 0 || iv[i] >= nv)
+            return cdl_pbrt_error(c, I ? I->line : c->line,
+                                  "%s: index %g (number %zu) out of range: there are %u points", what,
+                                  iv[i], i, nv);
+    if (N && (N->type != CDL_PT_NORMAL || N->n != P->n))
+        return cdl_pbrt_error(c, N->line, "%s: N must be %u normals (normal3), got %zu %s values", what,
+                              nv, N->n, N->tname);
+    if (UV && (!(UV->type == CDL_PT_FLOAT || UV->type == CDL_PT_POINT2) || UV->n != 2 * (size_t)nv))
+        return cdl_pbrt_error(c, UV->line, "%s: %s must be %u point2 (or 2 floats each), got %zu %s values",
+                              what, UV->name, nv, UV->n, UV->tname);
+    size_t nt = ni / per * (quads ? 2 : 1);
+    if (nt >= UINT32_MAX / 4)
+        return cdl_pbrt_error(c, c->line, "%s: too many triangles", what);
+    int rc = cdl_mesh_alloc(m, nv, (uint32_t)nt, N != NULL, UV != NULL, c->file, c->line, c->err);
+    if (rc)
+        return rc;
+    const double *pv = cdl_pbrt_nums(ps, P);
+    for (size_t i = 0; i < 3 * (size_t)nv; i++)
+        m->pos[i] = (float)pv[i];
+    if (N) {
+        const double *nv3 = cdl_pbrt_nums(ps, N);
+        for (size_t i = 0; i < 3 * (size_t)nv; i++)
+            m->nrm[i] = (float)nv3[i];
+    }
+    if (UV) {
+        const double *uv = cdl_pbrt_nums(ps, UV);
+        for (size_t i = 0; i < 2 * (size_t)nv; i++)
+            m->uv[i] = (float)uv[i];
+    }
+    uint32_t *t = m->idx;
+    for (size_t f = 0; f < ni; f += per) {
+        uint32_t a = (uint32_t)iv[f], b = (uint32_t)iv[f + 1], d = (uint32_t)iv[f + 2];
+        if (!quads) {
+            *t++ = a, *t++ = b, *t++ = d;
+        } else {
+            uint32_t e = (uint32_t)iv[f + 3]; /* p00 p10 p01 p11 */
+            *t++ = a, *t++ = b, *t++ = e;
+            *t++ = a, *t++ = e, *t++ = d;
+        }
+    }
+    return 0;
+}
+
+static int read_ply(cdl_pbrt_ctx *c, cdl_mesh *m)
+{
+    const char *fn;
+    char path[1024];
+    int rc = cdl_pbrt_get_string(&c->ps, "filename", NULL, &fn, c->err);
+    if (rc)
+        return rc;
+    if (!fn)
+        return cdl_pbrt_error(c, c->line, "plymesh needs \"string filename\"");
+    cdl_pbrt_resolve(c, fn, path, sizeof path);
+    if ((rc = cdl_pbrt_check_file(c, "plymesh file", path)))
+        return rc;
+    if ((rc = cdl_ply_read(path, m, c->err)))
+        return rc; /* names the PLY file and its problem; indices and numbers are checked */
+    if (m->nverts == 0 || m->ntris == 0)
+        return cdl_pbrt_error(c, c->line, "plymesh \"%s\" has no triangles", path);
+    return 0;
+}
+
+/* swap_def: the handedness of the transform the sphere was defined
+ * under. pbrt flips a sphere's normal by ReverseOrientation XOR it in
+ * object space; an instance transform only carries that normal along. */
+static int emit_shape(cdl_pbrt_ctx *c, const cdl_pbrt_shape *sh, const cdl_mat4 *ctm, int reverse,
+                      int swap_def, uint32_t mat, int32_t emit)
+{
+    if (!sh->sphere)
+        return cdl_scene_add_mesh(c->s, &sh->mesh, ctm, reverse, mat, emit, c->file, c->line, c->err);
+    double scale;
+    int inward = reverse ^ swap_def;
+    if (cdl_mat4_is_similarity(ctm, 1e-4, &scale)) {
+        cdl_vec3 ctr = cdl_mat4_point3(ctm, cdl_v3(0, 0, 0));
+        return cdl_pbrt_scene_rc(c, cdl_scene_add_sphere(c->s, ctr, (float)(sh->radius * scale), mat, emit,
+                                                         inward, c->err));
+    }
+    cdl_mesh m;
+    memset(&m, 0, sizeof m);
+    int rc = cdl_mesh_sphere(&m, sh->radius, inward, c->file, c->line, c->err);
+    if (!rc)
+        rc = cdl_scene_add_mesh(c->s, &m, ctm, reverse, mat, emit, c->file, c->line, c->err);
+    cdl_mesh_free(&m);
+    return rc;
+}
+
+static int read_sphere(cdl_pbrt_ctx *c, cdl_pbrt_shape *sh)
+{
+    cdl_pbrt_params *ps = &c->ps;
+    double r, zmin, zmax, phimax;
+    int rc;
+    if ((rc = cdl_pbrt_get_float(ps, "radius", 1.0, &r, c->err)))
+        return rc;
+    if (!(r > 0.0))
+        return cdl_pbrt_error(c, c->line, "sphere radius %g must be > 0", r);
+    if ((rc = cdl_pbrt_get_float(ps, "zmin", -r, &zmin, c->err)) ||
+        (rc = cdl_pbrt_get_float(ps, "zmax", r, &zmax, c->err)) ||
+        (rc = cdl_pbrt_get_float(ps, "phimax", 360.0, &phimax, c->err)))
+        return rc;
+    if (zmin > -r || zmax < r || phimax < 360.0)
+        cdl_pbrt_warn(c, c->line, "partial sphere (zmin, zmax, phimax) rendered as a full sphere");
+    sh->sphere = 1;
+    sh->radius = r;
+    return 0;
+}
+
+int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
+{
+    cdl_pbrt_shape sh;
+    memset(&sh, 0, sizeof sh);
+    int rc;
+    if (!strcmp(type, "trianglemesh"))
+        rc = read_mesh(c, 0, &sh.mesh);
+    else if (!strcmp(type, "bilinearmesh"))
+        rc = read_mesh(c, 1, &sh.mesh);
+    else if (!strcmp(type, "plymesh"))
+        rc = read_ply(c, &sh.mesh);
+    else if (!strcmp(type, "sphere"))
+        rc = read_sphere(c, &sh);
+    else {
+        cdl_pbrt_warn(c, c->line, "Shape \"%s\" is not supported (skipped)", type);
+        for (size_t i = 0; i < c->ps.n; i++)
+            c->ps.p[i].used = 1;
+        return 0;
+    }
+    if (rc) {
+        cdl_pbrt_shape_free(&sh);
+        return rc;
+    }
+    if (c->gs.mat == CDL_PBRT_MAT_NONE) {
+        if (!c->warned_none)
+            cdl_pbrt_warn(c, c->line, "shapes without a surface (material \"none\"/\"interface\") are skipped");
+        c->warned_none = 1;
+        cdl_pbrt_shape_free(&sh);
+        return 0;
+    }
+    int32_t mat;
+    if ((rc = cdl_pbrt_current_material(c, &mat))) {
+        cdl_pbrt_shape_free(&sh);
+        return rc;
+    }
+    if (c->cur_obj >= 0) {
+        /* kept in object space, instanced by ObjectInstance */
+        cdl_pbrt_object *o = &c->objs[c->cur_obj];
+        if (c->gs.area && !c->warned_inst_light) {
+            cdl_pbrt_warn(c, c->line, "area lights inside ObjectBegin are not supported (as in pbrt-v3): "
+                                      "the shapes do not emit");
+            c->warned_inst_light = 1;
+        }
+        if (o->n == o->cap) {
+            uint32_t cap = o->cap ? 2 * o->cap : 8;
+            cdl_pbrt_inst_shape *p = realloc(o->shapes, sizeof *p * cap);
+            if (!p) {
+                cdl_pbrt_shape_free(&sh);
+                return oom(c);
+            }
+            o->shapes = p;
+            o->cap = cap;
+        }
+        cdl_pbrt_inst_shape *r = &o->shapes[o->n];
+        r->shape = sh;
+        r->ctm = c->gs.ctm;
+        r->reverse = c->gs.reverse;
+        r->mat = mat;
+        r->line = c->line;
+        r->file = strdup(c->file);
+        if (!r->file) {
+            cdl_pbrt_shape_free(&sh);
+            return oom(c);
+        }
+        o->n++;
+        return 0;
+    }
+    int32_t emit = -1;
+    if (c->gs.area)
+        rc = cdl_pbrt_scene_rc(c, cdl_scene_add_emitter(c->s, c->gs.area_L, c->gs.area_twosided, &emit, c->err));
+    if (!rc)
+        rc = emit_shape(c, &sh, &c->gs.ctm, c->gs.reverse, cdl_mat4_swaps_handedness(&c->gs.ctm),
+                        (uint32_t)mat, emit);
+    c->nshapes++;
+    cdl_pbrt_shape_free(&sh);
+    return rc;
+}
+
+int cdl_pbrt_object_instance(cdl_pbrt_ctx *c, const char *name)
+{
+    int i = c->nobjs;
+    while (i-- > 0 && strcmp(c->objs[i].name, name))
+        ;
+    if (i < 0)
+        return cdl_pbrt_error(c, c->line, "ObjectInstance: object \"%s\" is not defined", name);
+    const cdl_pbrt_object *o = &c->objs[i];
+    for (uint32_t k = 0; k < o->n; k++) {
+        const cdl_pbrt_inst_shape *r = &o->shapes[k];
+        cdl_mat4 total = cdl_mat4_mul(&c->gs.ctm, &r->ctm);
+        int rc = emit_shape(c, &r->shape, &total, r->reverse, cdl_mat4_swaps_handedness(&r->ctm),
+                            (uint32_t)r->mat, -1);
+        if (rc)
+            return rc;
+        c->nshapes++;
+    }
+    return 0;
+}
