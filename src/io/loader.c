@@ -4,16 +4,11 @@
 #include <string.h>
 #include <strings.h>
 
-#include "io/obj_check.h"
 #include "io/mitsuba_loader.h"
+#include "io/obj_check.h"
 #include "io/obj_loader.h"
 #include "io/pbrt_loader.h"
-
-void cdl_scene_settings_init(cdl_scene_settings *set)
-{
-    memset(set, 0, sizeof *set);
-    set->maxdepth = -1;
-}
+#include "io/settings.h"
 
 static int has_ext(const char *path, const char *ext)
 {

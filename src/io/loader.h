@@ -5,9 +5,6 @@
 
 #include "scene/scene.h"
 
-
-void cdl_scene_settings_init(cdl_scene_settings *set);
-
 /* Loads path into an initialized, uncommitted scene; set may be NULL. */
 int cdl_scene_load(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_error *err);
 

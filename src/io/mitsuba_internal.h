@@ -14,7 +14,7 @@
 #include <stdint.h>
 
 #include "core/transform.h"
-#include "io/loader.h"
+#include "io/settings.h"
 #include "io/xml.h"
 
 #define CDL_MTS_MAX_INCLUDE 16
@@ -86,6 +86,8 @@ int cdl_mts_vec(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def,
 int cdl_mts_transform(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_mat4 *out);
 /* An object declared with id (ids are unique). */
 int cdl_mts_add_id(cdl_mts_ctx *c, const cdl_xml_node *n, const cdl_mts_id *v);
+/* <default name value>: defines name unless it is defined already. */
+int cdl_mts_default(cdl_mts_ctx *c, const cdl_xml_node *n);
 const cdl_mts_id *cdl_mts_find_id(cdl_mts_ctx *c, const char *id);
 
 /* mitsuba_shapes.c */

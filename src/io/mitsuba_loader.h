@@ -3,7 +3,7 @@
 #ifndef CDL_MITSUBA_LOADER_H
 #define CDL_MITSUBA_LOADER_H
 
-#include "io/loader.h"
+#include "io/settings.h"
 
 /* Loads path into an initialized, uncommitted scene; set may be NULL. */
 int cdl_load_mitsuba(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_error *err);

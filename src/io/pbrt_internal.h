@@ -8,7 +8,7 @@
 #include <stdint.h>
 
 #include "core/transform.h"
-#include "io/loader.h"
+#include "io/settings.h"
 #include "scene/mesh.h"
 #include "io/pbrt_lexer.h"
 #include "io/pbrt_params.h"

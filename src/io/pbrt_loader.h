@@ -2,7 +2,7 @@
 #ifndef CDL_PBRT_LOADER_H
 #define CDL_PBRT_LOADER_H
 
-#include "io/loader.h"
+#include "io/settings.h"
 
 int cdl_load_pbrt(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_error *err);
 

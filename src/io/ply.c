@@ -14,7 +14,7 @@
 
 #include "scene/scene.h"
 
-#include "io/ply_internal.h"
+#include "io/ply_format.h"
 
 void cdl_ply_free(cdl_ply_mesh *m)
 {

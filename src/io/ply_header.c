@@ -1,7 +1,7 @@
 /* PLY header parsing: the format line, element and property declarations,
  * the type table, and the roles of the properties the reader keeps. The
  * body is read by ply.c. */
-#include "io/ply_internal.h"
+#include "io/ply_format.h"
 
 #include <inttypes.h>
 #include <string.h>

@@ -537,17 +537,3 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
         kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
 }
-
-void cdl_scene_settings_param(cdl_scene_settings *set, const char *name, const char *value, const char *file,
-                              int line)
-{
-    if (set->nparams == CDL_MAX_SCENE_PARAMS) {
-        cdl_warn(file, line, "more than %d integrator parameters: \"%s\" ignored", CDL_MAX_SCENE_PARAMS, name);
-        return;
-    }
-    cdl_scene_param *p = &set->params[set->nparams++];
-    snprintf(p->name, sizeof p->name, "%s", name);
-    snprintf(p->value, sizeof p->value, "%s", value);
-    snprintf(p->file, sizeof p->file, "%s", file);
-    p->line = line;
-}

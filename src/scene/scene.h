@@ -53,9 +53,6 @@ typedef struct cdl_scene_settings {
     int nparams;
 } cdl_scene_settings;
 
-/* Adds an integrator parameter; past CDL_MAX_SCENE_PARAMS, a warning. */
-void cdl_scene_settings_param(cdl_scene_settings *set, const char *name, const char *value, const char *file,
-                              int line);
 
 /* Also the public API's scene handle (candela.h). */
 typedef struct cdl_scene {

@@ -37,7 +37,7 @@
 #include "core/log.h"
 #include "core/morton.h"
 #include "core/rng.h"
-#include "integrators/gkde/gkde.h"
+#include "integrators/gkde/points.h"
 
 #define LIGHT_CHUNK 1024
 

@@ -10,7 +10,7 @@
 
 #include "core/log.h"
 #include "core/rng.h"
-#include "integrators/gkde/gkde.h"
+#include "integrators/gkde/points.h"
 
 #define MAX_BUNDLE 4096 /* links per footprint and subtree traced at once */
 #define RANGE 0x80000000u /* a candidate record entry starting a range of points */

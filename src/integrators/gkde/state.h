@@ -1,9 +1,9 @@
-/* The state of the gkde integrator (Bekaert et al. 2003), shared by its
- * two halves: gkde.c (paths, footprints, calibration, the step's image)
- * and points.c (the eye points' kd-tree and stages 3 to 5: candidate
- * counting, trial linking, shadow rays and scores). */
-#ifndef CDL_INTEGRATORS_GKDE_H
-#define CDL_INTEGRATORS_GKDE_H
+/* The state of the gkde integrator (Bekaert et al. 2003): owned by gkde.c
+ * (paths, footprints, calibration, the step's image, the vtable), which
+ * calls points.c (points.h: the eye points' kd-tree and stages 3 to 5:
+ * candidate counting, trial linking, shadow rays and scores). */
+#ifndef CDL_GKDE_STATE_H
+#define CDL_GKDE_STATE_H
 
 #include <string.h>
 
@@ -93,12 +93,5 @@ static inline uint32_t gkde_pv_bucket(const gkde_state *s, uint32_t y)
     uint32_t d = s->evs.depth[y];
     return 6 * s->epix[y] + 2 * (d >= 3 ? 2 : d - 1);
 }
-
-/* The kd-tree over the eye vertices that can be linked (points in tree
- * order), the per-point arrays and the parts threads own. */
-int gkde_build_points(gkde_state *s, cdl_error *err);
-/* Stages 3 to 5; returns the shadow rays traced, UINT64_MAX when out of
- * memory for the candidate records. */
-uint64_t gkde_link_all(gkde_state *s, uint32_t pass);
 
 #endif
