@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/log.h"
@@ -208,6 +209,40 @@ static void obj_uvs(void)
     }
 }
 
+/* <path value>: a folder relative to the file it is in, searched before
+ * the main file's folder (the later <path> first); without it the mesh is
+ * not found. */
+static void search_paths(void)
+{
+    char sub[400];
+    snprintf(sub, sizeof sub, "%s/meshes", dir);
+    mkdir(sub, 0755);
+    snprintf(sub, sizeof sub, "%s/other", dir);
+    mkdir(sub, 0755);
+    write_file("meshes/quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+    write_file("other/quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const char *shape = "<shape type=\"obj\"><string name=\"filename\" value=\"quad.obj\"/></shape>\n";
+    char xml[1024];
+    cdl_scene s;
+    cdl_scene_settings set;
+    snprintf(xml, sizeof xml, "<scene version=\"3.0.0\">\n" LIGHT "%s</scene>\n", shape);
+    write_file("nopath.xml", xml);
+    int rc = load("nopath.xml", &s, &set);
+    CHECK(rc != 0, "a mesh in a subfolder without <path> is not found");
+    if (!rc)
+        cdl_scene_free(&s);
+    snprintf(xml, sizeof xml,
+             "<scene version=\"3.0.0\">\n<path value=\"other\"/>\n<path value=\"meshes\"/>\n" LIGHT "%s</scene>\n",
+             shape);
+    write_file("path.xml", xml);
+    if (load("path.xml", &s, &set)) {
+        CHECK(0, "<path> finds the mesh");
+        return;
+    }
+    CHECK(s.ntris == 2, "the later <path> is searched first: %u triangles (meshes/quad.obj has 2)", s.ntris);
+    cdl_scene_free(&s);
+}
+
 /* Each texel of an 8 x 4 map is seen in Mitsuba's direction for it:
  * local d = (sin phi sin theta, cos theta, -cos phi sin theta) with
  * phi = 2 pi u, theta = pi v, turned by to_world. */
@@ -313,6 +348,7 @@ int main(int argc, char **argv)
     camera_and_transforms();
     materials_and_include();
     obj_uvs();
+    search_paths();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

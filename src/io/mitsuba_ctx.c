@@ -181,10 +181,34 @@ void cdl_mts_warn_unused(cdl_mts_ctx *c, cdl_xml_node *n, const char *what)
     }
 }
 
+int cdl_mts_add_path(cdl_mts_ctx *c, const cdl_xml_node *n)
+{
+    int rc = 0;
+    const char *v = cdl_mts_attr(c, n, "value", &rc);
+    if (rc)
+        return rc;
+    if (!v || !*v)
+        return cdl_mts_error(c, n->line, "<path> needs a \"value\"");
+    if (c->npaths == CDL_MTS_MAX_PATHS)
+        return cdl_mts_error(c, n->line, "more than %d <path> elements", CDL_MTS_MAX_PATHS);
+    char *dir = c->paths[c->npaths];
+    cdl_path_join_dir(c->file, v, dir, sizeof c->paths[0]);
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        cdl_mts_warn(c, n->line, "<path> \"%s\" is not a folder (searched anyway)", dir);
+    c->npaths++;
+    return 0;
+}
+
 int cdl_mts_path(cdl_mts_ctx *c, int line, const char *name, char *out, size_t n)
 {
-    cdl_path_join_dir(c->main_path, name, out, n);
     struct stat st;
+    for (int i = c->npaths - 1; i >= 0 && name[0] != '/'; i--) {
+        snprintf(out, n, "%s/%s", c->paths[i], name);
+        if (stat(out, &st) == 0 && S_ISREG(st.st_mode))
+            return 0;
+    }
+    cdl_path_join_dir(c->main_path, name, out, n);
     if (stat(out, &st) != 0)
         return cdl_mts_error(c, line, "\"%s\" cannot be opened: %s", out, strerror(errno));
     if (!S_ISREG(st.st_mode))

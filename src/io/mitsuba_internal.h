@@ -34,6 +34,8 @@ typedef struct cdl_mts_var {
     char *name, *value;
 } cdl_mts_var;
 
+#define CDL_MTS_MAX_PATHS 16
+
 typedef struct cdl_mts_ctx {
     cdl_scene *s;
     cdl_scene_settings *set;
@@ -46,6 +48,8 @@ typedef struct cdl_mts_ctx {
     cdl_mts_id *ids;
     int nids, capids;
     int32_t default_mat;    /* Mitsuba's default bsdf (diffuse 0.5), made on first use, or -1 */
+    char paths[CDL_MTS_MAX_PATHS][1024]; /* <path> folders, searched last given first */
+    int npaths;
     int saw_sensor;
     uint32_t nshapes;
     char buf[4096];         /* an attribute after $variable substitution */
@@ -88,6 +92,10 @@ int cdl_mts_transform(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_mat
 int cdl_mts_add_id(cdl_mts_ctx *c, const cdl_xml_node *n, const cdl_mts_id *v);
 /* <default name value>: defines name unless it is defined already. */
 int cdl_mts_default(cdl_mts_ctx *c, const cdl_xml_node *n);
+/* <path value>: a folder (relative to the file it is in) searched for
+ * relative file names before the main file's folder, as Mitsuba's file
+ * resolver does. */
+int cdl_mts_add_path(cdl_mts_ctx *c, const cdl_xml_node *n);
 const cdl_mts_id *cdl_mts_find_id(cdl_mts_ctx *c, const char *id);
 
 /* mitsuba_shapes.c */

@@ -222,6 +222,8 @@ static int element(cdl_mts_ctx *c, cdl_xml_node *n)
     n->used = 1;
     if (!strcmp(n->name, "default"))
         return cdl_mts_default(c, n);
+    if (!strcmp(n->name, "path"))
+        return cdl_mts_add_path(c, n);
     if (!strcmp(n->name, "include")) {
         const char *fn = cdl_mts_attr(c, n, "filename", &rc);
         char path[1024];
