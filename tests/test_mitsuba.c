@@ -209,6 +209,35 @@ static void obj_uvs(void)
     }
 }
 
+/* Spectra: three numbers are RGB (Mitsuba 0.6's RGB build); wavelength
+ * pairs go through the CIE observer, reflectances under D65 (a constant
+ * spectrum is grey, a long-wavelength one red), not averaged to grey. */
+static void spectra(void)
+{
+    write_file("spec.xml",
+               "<scene version=\"3.0.0\">\n" LIGHT
+               "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" "
+               "value=\"0.2 0.4 0.6\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" "
+               "value=\"400:0.5, 700:0.5\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" "
+               "value=\"400:0.05, 550:0.05, 600:0.6, 700:0.6\"/></bsdf></shape>\n"
+               "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("spec.xml", &s, &set)) {
+        CHECK(0, "spec.xml loads");
+        return;
+    }
+    const cdl_material *m = s.mats;
+    CHECK(s.nmats == 3 && near3(m[0].kd, cdl_v3(0.2f, 0.4f, 0.6f), 1e-6f), "three-number spectrum as RGB");
+    CHECK(near3(m[1].kd, cdl_v3(0.5f, 0.5f, 0.5f), 1e-4f), "constant spectrum 0.5 gives (%g, %g, %g)",
+          (double)m[1].kd.x, (double)m[1].kd.y, (double)m[1].kd.z);
+    CHECK(m[2].kd.x > 0.4f && m[2].kd.y < 0.25f && m[2].kd.z < 0.1f, "a red wall's spectrum reads red: (%g, %g, %g)",
+          (double)m[2].kd.x, (double)m[2].kd.y, (double)m[2].kd.z);
+    cdl_scene_free(&s);
+}
+
 /* <path value>: a folder relative to the file it is in, searched before
  * the main file's folder (the later <path> first); without it the mesh is
  * not found. */
@@ -349,6 +378,7 @@ int main(int argc, char **argv)
     materials_and_include();
     obj_uvs();
     search_paths();
+    spectra();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

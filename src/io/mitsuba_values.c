@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/spectrum.h"
 #include "io/mitsuba_internal.h"
 /* Up to max numbers separated by commas and/or white space; *count gets
  * how many there were (more than max is an error). */
@@ -166,35 +167,43 @@ int cdl_mts_color_node(cdl_mts_ctx *c, cdl_xml_node *p, cdl_vec3 *out)
         *out = is_srgb ? cdl_v3(srgb_to_linear(x[0]), srgb_to_linear(x[1]), srgb_to_linear(x[2]))
                        : cdl_v3((float)x[0], (float)x[1], (float)x[2]);
     } else if (!strcmp(p->name, "spectrum")) {
-        if (strchr(v, ':')) { /* wavelength:value pairs: their mean, a grey */
-            double sum = 0.0;
+        if (strchr(v, ':')) { /* wavelength:value pairs through the CIE observer */
+            double lam[64], val[64];
             int m = 0;
             for (const char *q = v; *q;) {
                 char *end;
-                strtod(q, &end);
-                if (end == q || *end != ':')
-                    return cdl_mts_error(c, p->line, "<spectrum> \"%s\" is not a list of wavelength:value", v);
+                double l = strtod(q, &end);
+                if (end == q || *end != ':' || !isfinite(l) || (m > 0 && !(l > lam[m - 1])))
+                    return cdl_mts_error(c, p->line,
+                                         "<spectrum> \"%s\" is not a list of increasing wavelength:value", v);
                 q = end + 1;
                 double y = strtod(q, &end);
                 if (end == q || !isfinite(y))
                     return cdl_mts_error(c, p->line, "<spectrum> \"%s\" is not a list of wavelength:value", v);
-                sum += y;
-                m++;
+                if (m == 64)
+                    return cdl_mts_error(c, p->line, "<spectrum> \"%s\": more than 64 wavelengths", v);
+                lam[m] = l;
+                val[m++] = y;
                 q = end;
                 while (isspace((unsigned char)*q) || *q == ',')
                     q++;
             }
             if (m == 0)
                 return cdl_mts_error(c, p->line, "<spectrum> \"%s\" is empty", v);
-            cdl_mts_warn(c, p->line, "<spectrum> with wavelengths: approximated by its mean, a grey");
-            *out = cdl_v3((float)(sum / m), (float)(sum / m), (float)(sum / m));
+            /* emitted quantities integrate against the observer alone,
+             * reflectances under D65 (Mitsuba 3's unbounded and bounded) */
+            const char *name = cdl_xml_attr_get(p, "name");
+            int emitted = name && (!strcmp(name, "radiance") || !strcmp(name, "intensity") ||
+                                   !strcmp(name, "irradiance") || !strcmp(name, "power"));
+            *out = cdl_spectrum_to_srgb(lam, val, m, !emitted);
             return 0;
         }
-        if ((rc = numbers(c, p, "value", v, x, 1, &k)))
+        if ((rc = numbers(c, p, "value", v, x, 3, &k)))
             return rc;
-        if (k != 1)
-            return cdl_mts_error(c, p->line, "<spectrum> \"%s\": give one number or wavelength:value pairs", v);
-        *out = cdl_v3((float)x[0], (float)x[0], (float)x[0]);
+        if (k != 1 && k != 3)
+            return cdl_mts_error(c, p->line, "<spectrum> \"%s\": give one number, three (RGB, as Mitsuba 0.6's RGB "
+                                 "build reads them) or wavelength:value pairs", v);
+        *out = k == 3 ? cdl_v3((float)x[0], (float)x[1], (float)x[2]) : cdl_v3((float)x[0], (float)x[0], (float)x[0]);
     } else if (!strcmp(p->name, "float")) {
         double f;
         if ((rc = one_number(c, p, &f)))

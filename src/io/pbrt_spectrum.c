@@ -2,26 +2,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/spectrum.h"
 #include "io/pbrt_params.h"
-
-/* CIE 1931 2-degree colour matching functions, 380..780 nm in 10 nm steps. */
-#define CIE_N 41
-static const double CIE[CIE_N][3] = {
-    {0.001368, 0.000039, 0.006450}, {0.004243, 0.000120, 0.020050}, {0.014310, 0.000396, 0.067850},
-    {0.043510, 0.001210, 0.207400}, {0.134380, 0.004000, 0.645600}, {0.283900, 0.011600, 1.385600},
-    {0.348280, 0.023000, 1.747060}, {0.336200, 0.038000, 1.772110}, {0.290800, 0.060000, 1.669200},
-    {0.195360, 0.090980, 1.287640}, {0.095640, 0.139020, 0.812950}, {0.032010, 0.208020, 0.465180},
-    {0.004900, 0.323000, 0.272000}, {0.009300, 0.503000, 0.158200}, {0.063270, 0.710000, 0.078250},
-    {0.165500, 0.862000, 0.042160}, {0.290400, 0.954000, 0.020300}, {0.433450, 0.994950, 0.008750},
-    {0.594500, 0.995000, 0.003900}, {0.762100, 0.952000, 0.002100}, {0.916300, 0.870000, 0.001650},
-    {1.026300, 0.757000, 0.001100}, {1.062200, 0.631000, 0.000800}, {1.002600, 0.503000, 0.000340},
-    {0.854450, 0.381000, 0.000190}, {0.642400, 0.265000, 0.000050}, {0.447900, 0.175000, 0.000020},
-    {0.283500, 0.107000, 0.000000}, {0.164900, 0.061000, 0.000000}, {0.087400, 0.032000, 0.000000},
-    {0.046770, 0.017000, 0.000000}, {0.022700, 0.008210, 0.000000}, {0.011359, 0.004102, 0.000000},
-    {0.005790, 0.002091, 0.000000}, {0.002899, 0.001047, 0.000000}, {0.001440, 0.000520, 0.000000},
-    {0.000690, 0.000249, 0.000000}, {0.000332, 0.000120, 0.000000}, {0.000166, 0.000060, 0.000000},
-    {0.000083, 0.000030, 0.000000}, {0.000042, 0.000015, 0.000000},
-};
 
 /* Planck's law with pbrt-v3's constants; lambda in nm. */
 static double planck(double lambda_nm, double T)
@@ -34,9 +16,7 @@ static double planck(double lambda_nm, double T)
 /* pbrt-v3's XYZToRGB (sRGB primaries, D65 white). */
 cdl_vec3 cdl_pbrt_xyz_to_rgb(double x, double y, double z)
 {
-    return cdl_v3((float)(3.240479 * x - 1.537150 * y - 0.498535 * z),
-                  (float)(-0.969256 * x + 1.875991 * y + 0.041556 * z),
-                  (float)(0.055648 * x - 0.204043 * y + 1.057311 * z));
+    return cdl_xyz_to_srgb(x, y, z);
 }
 
 cdl_vec3 cdl_pbrt_blackbody(double T, int v4)
@@ -44,11 +24,11 @@ cdl_vec3 cdl_pbrt_blackbody(double T, int v4)
     /* peak normalization as pbrt's BlackbodyNormalized (Wien's law) */
     double peak = planck(2.8977721e-3 / T * 1e9, T);
     double xyz[3] = {0, 0, 0}, yint = 0.0;
-    for (int i = 0; i < CIE_N; i++) {
+    for (int i = 0; i < CDL_CIE_N; i++) {
         double b = planck(380.0 + 10.0 * i, T) / peak;
         for (int k = 0; k < 3; k++)
-            xyz[k] += CIE[i][k] * b;
-        yint += CIE[i][1];
+            xyz[k] += cdl_cie_xyz[i][k] * b;
+        yint += cdl_cie_xyz[i][1];
     }
     /* v3: divide by the integral of y-bar (an equal-energy 1 has Y = 1);
      * v4: lights are scaled to luminance 1 (SpectrumToPhotometric) */
