@@ -211,7 +211,8 @@ static void obj_uvs(void)
 
 /* Spectra: three numbers are RGB (Mitsuba 0.6's RGB build); wavelength
  * pairs go through the CIE observer, reflectances under D65 (a constant
- * spectrum is grey, a long-wavelength one red), not averaged to grey. */
+ * spectrum is grey, a long-wavelength one red), not averaged to grey. A
+ * negative conductor eta is taken as Mitsuba takes it. */
 static void spectra(void)
 {
     write_file("spec.xml",
@@ -222,6 +223,8 @@ static void spectra(void)
                "value=\"400:0.5, 700:0.5\"/></bsdf></shape>\n"
                "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" "
                "value=\"400:0.05, 550:0.05, 600:0.6, 700:0.6\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"conductor\"><rgb name=\"eta\" value=\"-0.2, -0.9, 1.1\"/>"
+               "<rgb name=\"k\" value=\"3.9, 2.4, 2.1\"/></bsdf></shape>\n"
                "</scene>\n");
     cdl_scene s;
     cdl_scene_settings set;
@@ -230,7 +233,8 @@ static void spectra(void)
         return;
     }
     const cdl_material *m = s.mats;
-    CHECK(s.nmats == 3 && near3(m[0].kd, cdl_v3(0.2f, 0.4f, 0.6f), 1e-6f), "three-number spectrum as RGB");
+    CHECK(s.nmats == 4 && near3(m[0].kd, cdl_v3(0.2f, 0.4f, 0.6f), 1e-6f), "three-number spectrum as RGB");
+    CHECK(near3(m[3].eta3, cdl_v3(0.2f, 0.9f, 1.1f), 1e-6f), "a negative conductor eta is read as its magnitude");
     CHECK(near3(m[1].kd, cdl_v3(0.5f, 0.5f, 0.5f), 1e-4f), "constant spectrum 0.5 gives (%g, %g, %g)",
           (double)m[1].kd.x, (double)m[1].kd.y, (double)m[1].kd.z);
     CHECK(m[2].kd.x > 0.4f && m[2].kd.y < 0.25f && m[2].kd.z < 0.1f, "a red wall's spectrum reads red: (%g, %g, %g)",

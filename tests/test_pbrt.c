@@ -57,6 +57,13 @@ static int near3(cdl_vec3 a, cdl_vec3 b, float tol)
 
 #define V3(v) (double)(v).x, (double)(v).y, (double)(v).z
 
+static void count_warning(void *user, const char *file, int line, const char *msg)
+{
+    (void)file;
+    (void)msg;
+    *(int *)user += line == 2;
+}
+
 static const char *LIGHT = "LightSource \"point\" \"rgb I\" [1 1 1] \"point from\" [0 0 10]\n";
 static const char *TRI = "Shape \"trianglemesh\" \"integer indices\" [0 1 2] "
                          "\"point P\" [1 0 0  0 1 0  0 0 1]\n";
@@ -422,6 +429,34 @@ static void test_materials(void)
     CHECK(m[9]->type == CDL_MAT_DIFFUSE && near3(m[9]->kd, cdl_v3(0.7f, 0.6f, 0.5f), 1e-6f),
           "v4 diffuse reflectance (%g %g %g)", V3(m[9]->kd));
     cdl_scene_free(&s);
+
+    /* a spot whose conedelta (default 5) exceeds its coneangle: pbrt renders
+     * it, the falloff clamped to start at the axis; a warning names the line */
+    snprintf(text, sizeof text,
+             "WorldBegin\nLightSource \"spot\" \"rgb I\" [1 1 1] \"float coneangle\" 3\n%s", TRI);
+    write_file("spot.pbrt", text);
+    int warned = 0;
+    cdl_log_sink count = {count_warning, &warned, 0};
+    const cdl_log_sink *prev = cdl_log_push(&count);
+    rc = load("spot.pbrt", &s, &set, &err);
+    cdl_log_pop(prev);
+    CHECK(!rc && warned == 1 && s.nlights == 1 && fabsf(s.lights[0].cos_falloff - 1.0f) < 1e-6f &&
+              fabsf(s.lights[0].cos_total - cosf(3.0f * CDL_PI / 180.0f)) < 1e-6f,
+          "spot coneangle 3 < conedelta 5 loads, clamped, with %d warning", warned);
+    if (!rc)
+        cdl_scene_free(&s);
+
+    /* an area light on Material "none" still emits (pbrt lets rays through
+     * the surface; candela's is black), with a warning */
+    snprintf(text, sizeof text,
+             "WorldBegin\nAttributeBegin\nMaterial \"none\"\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n"
+             "Shape \"sphere\" \"float radius\" 0.2\nAttributeEnd\n%s", TRI);
+    write_file("none.pbrt", text);
+    rc = load("none.pbrt", &s, &set, &err);
+    CHECK(!rc && s.nspheres == 1 && s.nlights == 1 && s.nmats == 2 && s.mats[0].kd.x == 0.0f,
+          "an area light on material none emits: %u spheres, %u lights", s.nspheres, s.nlights);
+    if (!rc)
+        cdl_scene_free(&s);
 
     /* blackbody: pbrt-v4 (one value) normalizes to luminance 1 */
     snprintf(text, sizeof text, "WorldBegin\nLightSource \"point\" \"blackbody I\" [6500] \"float scale\" 2\n%s", TRI);

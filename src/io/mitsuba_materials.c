@@ -91,6 +91,28 @@ static int color(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def
     return 0;
 }
 
+/* A conductor's eta. Mitsuba takes a negative one and its Fresnel term
+ * reads only eta squared: the magnitude, with a warning. */
+static int conductor_eta(cdl_mts_ctx *c, cdl_xml_node *n, cdl_vec3 def, cdl_vec3 *out)
+{
+    cdl_xml_node *p = cdl_mts_prop(c, n, "eta");
+    if (!p || !strcmp(p->name, "ref") || !strcmp(p->name, "texture"))
+        return color(c, n, "eta", def, out, NULL);
+    cdl_vec3 v;
+    int rc = cdl_mts_color_node(c, p, &v);
+    if (rc)
+        return rc;
+    if (!cdl_is_finite3(v))
+        return cdl_mts_error(c, p->line, "eta must be finite");
+    if (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f) {
+        cdl_mts_warn(c, p->line, "conductor eta (%g, %g, %g) is negative: its magnitude is used (the same Fresnel term)",
+                     (double)v.x, (double)v.y, (double)v.z);
+        v = cdl_v3(fabsf(v.x), fabsf(v.y), fabsf(v.z));
+    }
+    *out = v;
+    return 0;
+}
+
 /* Reflectances above 1 create energy: clamped, with a warning. */
 static cdl_vec3 at_most_one(cdl_mts_ctx *c, int line, const char *what, cdl_vec3 v)
 {
@@ -200,7 +222,7 @@ static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
             cdl_pbrt_named_spectrum("metal-Cu-k", &m->k3);
         }
     }
-    if ((rc = color(c, n, "eta", m->eta3, &m->eta3, NULL)) || (rc = color(c, n, "k", m->k3, &m->k3, NULL)) ||
+    if ((rc = conductor_eta(c, n, m->eta3, &m->eta3)) || (rc = color(c, n, "k", m->k3, &m->k3, NULL)) ||
         (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
         (rc = roughness(c, n, rough, m)))
         return rc;

@@ -427,11 +427,11 @@ int cdl_obj_check(const char *path, cdl_error *err)
         int found = 0;
         for (int k = 0; k < c.names.n && !found; k++)
             found = !strcmp(c.names.names[k], c.use[i]);
-        if (!found)
-            rc = cdl_error_set(err, CDL_ERR_INPUT, path, c.use_line[i],
-                               c.nmtllib ? "usemtl '%s': no such material in the MTL files"
-                                         : "usemtl '%s' but the file names no mtllib",
-                               c.use[i]);
+        if (!found) /* Assimp, like the renderers OBJ comes from, gives such faces a default material */
+            cdl_warn(path, c.use_line[i],
+                     c.nmtllib ? "usemtl '%s': no such material in the MTL files (a default diffuse is used)"
+                               : "usemtl '%s' but the file names no mtllib (a default diffuse is used)",
+                     c.use[i]);
     }
     for (int i = 0; i < c.nuse; i++)
         free(c.use[i]);

@@ -102,6 +102,7 @@ typedef struct cdl_pbrt_ctx {
     int nobjs, capobjs;
     int cur_obj;               /* object being defined or -1 */
     int32_t default_mat;       /* scene index of pbrt's default material or -1 */
+    int32_t black_mat;         /* an emitter's surface under Material "none", or -1 */
     uint32_t nshapes;          /* shapes that produced geometry */
     int warned_none, warned_inst_light;
 } cdl_pbrt_ctx;

@@ -126,7 +126,11 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         return rc;
     if (!(cone > 0.0 && cone <= 180.0))
         return cdl_pbrt_error(c, c->line, "spot coneangle %g must be in (0, 180] degrees", cone);
-    if (!(cdelta >= 0.0 && cdelta <= cone))
-        return cdl_pbrt_error(c, c->line, "spot conedelta %g must be in [0, coneangle = %g]", cdelta, cone);
+    if (!(cdelta >= 0.0))
+        return cdl_pbrt_error(c, c->line, "spot conedelta %g must not be negative", cdelta);
+    if (cdelta > cone) { /* pbrt renders it: the falloff then starts at the axis */
+        cdl_pbrt_warn(c, c->line, "spot conedelta %g exceeds coneangle %g: clamped to it", cdelta, cone);
+        cdelta = cone;
+    }
     return cdl_pbrt_scene_rc(c, cdl_scene_add_spot_light(c->s, P, D, v, (float)cone, (float)cdelta, err));
 }

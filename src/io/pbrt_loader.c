@@ -677,6 +677,7 @@ int cdl_load_pbrt(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_e
     c->gs.mat = CDL_PBRT_MAT_DEFAULT;
     c->cur_obj = -1;
     c->default_mat = -1;
+    c->black_mat = -1;
     /* what pbrt renders when the file does not say: 640x480, 16 spp,
      * path tracing with maxdepth 5, a camera at the origin looking down +z */
     set->width = 640;

@@ -7,6 +7,7 @@
  * swapping transform. We store every triangle with its pbrt normal as CCW. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -191,15 +192,31 @@ int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
         cdl_pbrt_shape_free(&sh);
         return rc;
     }
-    if (c->gs.mat == CDL_PBRT_MAT_NONE) {
+    int32_t mat;
+    if (c->gs.mat == CDL_PBRT_MAT_NONE && !c->gs.area) {
         if (!c->warned_none)
             cdl_pbrt_warn(c, c->line, "shapes without a surface (material \"none\"/\"interface\") are skipped");
         c->warned_none = 1;
         cdl_pbrt_shape_free(&sh);
         return 0;
     }
-    int32_t mat;
-    if ((rc = cdl_pbrt_current_material(c, &mat))) {
+    if (c->gs.mat == CDL_PBRT_MAT_NONE) {
+        /* pbrt's light emits and lets rays through; candela's emits and absorbs */
+        cdl_pbrt_warn(c, c->line, "an area light on material \"none\" emits from a black surface (pbrt's lets "
+                                  "rays pass)");
+        if (c->black_mat < 0) {
+            cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
+            m.kd = cdl_v3(0, 0, 0);
+            snprintf(m.name, sizeof m.name, "pbrt-none-emitter");
+            uint32_t id;
+            if ((rc = cdl_pbrt_scene_rc(c, cdl_scene_add_material(c->s, &m, &id, c->err)))) {
+                cdl_pbrt_shape_free(&sh);
+                return rc;
+            }
+            c->black_mat = (int32_t)id;
+        }
+        mat = c->black_mat;
+    } else if ((rc = cdl_pbrt_current_material(c, &mat))) {
         cdl_pbrt_shape_free(&sh);
         return rc;
     }

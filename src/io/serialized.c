@@ -14,6 +14,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "core/log.h"
 #include "scene/scene.h"
 
 #define SER_ID 0x041Cu
@@ -423,9 +424,9 @@ static int skip_name(ser_ctx *c)
 
 static int check_flags(ser_ctx *c, uint32_t flags)
 {
-    if (flags & ~(uint32_t)F_KNOWN)
-        return shape_fail(c, "unknown flags 0x%" PRIx32 " (flags 0x%" PRIx32 ")", flags & ~(uint32_t)F_KNOWN,
-                          flags);
+    if (flags & ~(uint32_t)F_KNOWN) /* Mitsuba reads past bits it does not know */
+        cdl_warn(c->path, 0, "shape %" PRIu32 ": unknown flags 0x%" PRIx32 " (flags 0x%" PRIx32 ") ignored", c->shape,
+                 flags & ~(uint32_t)F_KNOWN, flags);
     if ((flags & F_SINGLE) && (flags & F_DOUBLE))
         return shape_fail(c, "flags 0x%" PRIx32 " mark the data both single and double precision", flags);
     return 0;
