@@ -242,6 +242,40 @@ static void spectra(void)
     cdl_scene_free(&s);
 }
 
+/* A cylinder from p0 to p1 (along x) of radius 0.5: its area and normals
+ * outwards, inwards with flip_normals. */
+static void cylinder(void)
+{
+    for (int flip = 0; flip < 2; flip++) {
+        char xml[768];
+        snprintf(xml, sizeof xml,
+                 "<scene version=\"3.0.0\">\n<shape type=\"cylinder\"><point name=\"p0\" x=\"1\" y=\"2\" z=\"3\"/>"
+                 "<point name=\"p1\" x=\"4\" y=\"2\" z=\"3\"/><float name=\"radius\" value=\"0.5\"/>%s"
+                 "<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>\n</scene>\n",
+                 flip ? "<boolean name=\"flip_normals\" value=\"true\"/>" : "");
+        write_file("cyl.xml", xml);
+        cdl_scene s;
+        cdl_scene_settings set;
+        if (load("cyl.xml", &s, &set)) {
+            CHECK(0, "cyl.xml loads");
+            return;
+        }
+        double area = 0.0;
+        int outward = 0;
+        for (uint32_t i = 0; i < s.nlights; i++) {
+            const cdl_light *l = &s.lights[i];
+            cdl_vec3 cc = cdl_add(l->p, cdl_scale(cdl_add(l->e1, l->e2), 1.0f / 3.0f));
+            area += l->area;
+            outward += (l->n.y * (cc.y - 2.0f) + l->n.z * (cc.z - 3.0f)) * (flip ? -1.0f : 1.0f) > 0.0f &&
+                       fabsf(l->n.x) < 1e-4f && cc.x > 1.0f && cc.x < 4.0f;
+        }
+        CHECK(fabs(area / (PI * 3.0) - 1.0) < 1e-3 && outward == (int)s.nlights && s.nlights > 0,
+              "cylinder%s: area %.4f (%.4f), %d of %u triangles facing %s", flip ? " flipped" : "", area, PI * 3.0,
+              outward, s.nlights, flip ? "in" : "out");
+        cdl_scene_free(&s);
+    }
+}
+
 /* <path value>: a folder relative to the file it is in, searched before
  * the main file's folder (the later <path> first); without it the mesh is
  * not found. */
@@ -383,6 +417,7 @@ int main(int argc, char **argv)
     obj_uvs();
     search_paths();
     spectra();
+    cylinder();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

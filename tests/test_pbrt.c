@@ -458,6 +458,47 @@ static void test_materials(void)
     if (!rc)
         cdl_scene_free(&s);
 
+    /* disk, annulus, half disk and cylinder area lights: their areas (128
+     * segments a full turn: 0.04 % short of the circle) and orientation
+     * (a disk faces +z, a cylinder outwards, ReverseOrientation flips) */
+    struct {
+        const char *shape;
+        double area;
+        int axis, outward; /* the normal's sign along +z, or outwards from the z axis */
+    } round[] = {
+        {"\"disk\" \"float radius\" 2", CDL_PI * 4.0, 1, 0},
+        {"\"disk\" \"float radius\" 2 \"float innerradius\" 1 \"float height\" 0.5", CDL_PI * 3.0, 1, 0},
+        {"\"disk\" \"float radius\" 2 \"float phimax\" 180", CDL_PI * 2.0, 1, 0},
+        {"\"cylinder\" \"float radius\" 1 \"float zmin\" -1 \"float zmax\" 1", CDL_PI * 4.0, 0, 1},
+    };
+    for (int rev = 0; rev < 2; rev++)
+        for (size_t k = 0; k < sizeof round / sizeof round[0]; k++) {
+            snprintf(text, sizeof text,
+                     "WorldBegin\nAttributeBegin\n%sAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\nShape %s\n"
+                     "AttributeEnd\n",
+                     rev ? "ReverseOrientation\n" : "", round[k].shape);
+            write_file("round.pbrt", text);
+            rc = load("round.pbrt", &s, &set, &err);
+            double area = 0.0;
+            int oriented = 0;
+            for (uint32_t i = 0; !rc && i < s.nlights; i++) {
+                const cdl_light *l = &s.lights[i];
+                area += l->area;
+                float sgn = rev ? -1.0f : 1.0f;
+                if (round[k].axis)
+                    oriented += l->n.z * sgn > 0.99f;
+                else { /* the centroid's direction from the axis */
+                    cdl_vec3 cc = cdl_add(l->p, cdl_scale(cdl_add(l->e1, l->e2), 1.0f / 3.0f));
+                    oriented += (l->n.x * cc.x + l->n.y * cc.y) * sgn > 0.0f && fabsf(l->n.z) < 1e-4f;
+                }
+            }
+            CHECK(!rc && fabs(area / round[k].area - 1.0) < 1e-3 && s.nlights > 0 && oriented == (int)s.nlights,
+                  "Shape %s%s: %u lights, area %.4f (%.4f), %d oriented", round[k].shape,
+                  rev ? " reversed" : "", s.nlights, area, round[k].area, oriented);
+            if (!rc)
+                cdl_scene_free(&s);
+        }
+
     /* blackbody: pbrt-v4 (one value) normalizes to luminance 1 */
     snprintf(text, sizeof text, "WorldBegin\nLightSource \"point\" \"blackbody I\" [6500] \"float scale\" 2\n%s", TRI);
     write_file("bb.pbrt", text);

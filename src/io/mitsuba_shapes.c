@@ -1,5 +1,6 @@
 /* Mitsuba shapes: meshes from OBJ, PLY and serialized files, the built-in
- * rectangle, cube, disk and sphere, each with its bsdf and area emitter.
+ * rectangle, cube, disk, sphere and cylinder, each with its bsdf and area
+ * emitter.
  * Orientation is Mitsuba's: a triangle faces its shading normals when the
  * mesh has them, else its counter-clockwise normal after the transform
  * (Mitsuba does not flip faces under mirroring transforms, unlike pbrt);
@@ -90,6 +91,31 @@ static int disk(cdl_mts_ctx *c, int line, cdl_mesh *m)
     return 0;
 }
 
+/* Mitsuba's cylinder: radius about the segment p0 -> p1, open ends,
+ * normals outwards; its frame goes before to_world (*xf). */
+static int cylinder(cdl_mts_ctx *c, cdl_xml_node *n, cdl_mesh *m, cdl_mat4 *xf)
+{
+    cdl_vec3 p0, p1;
+    double r;
+    int rc;
+    if ((rc = cdl_mts_vec(c, n, "p0", cdl_v3(0, 0, 0), &p0, NULL)) ||
+        (rc = cdl_mts_vec(c, n, "p1", cdl_v3(0, 0, 1), &p1, NULL)) || (rc = cdl_mts_float(c, n, "radius", 1.0, &r)))
+        return rc;
+    cdl_vec3 d = cdl_sub(p1, p0);
+    float len = cdl_length(d);
+    if (!(r > 0.0 && r <= CDL_MAX_COORD) || !(len > 0.0f))
+        return cdl_mts_error(c, n->line, "cylinder radius %g and p0 != p1 needed", r);
+    cdl_frame f = cdl_frame_from(cdl_scale(d, 1.0f / len)); /* right-handed: t x b = n */
+    const float col[4][3] = {{f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z}, {f.n.x, f.n.y, f.n.z}, {p0.x, p0.y, p0.z}};
+    const double scale[4] = {r, r, len, 1.0};
+    cdl_mat4 local = cdl_mat4_identity();
+    for (int k = 0; k < 3; k++)
+        for (int j = 0; j < 4; j++)
+            local.m[k][j] = col[j][k] * scale[j];
+    *xf = cdl_mat4_mul(xf, &local);
+    return cdl_mesh_cylinder(m, 1.0, 0.0, 1.0, 2.0 * PI, DISK_SEGMENTS, c->file, n->line, c->err);
+}
+
 static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh *m)
 {
     char fn[1024], path[1024];
@@ -145,7 +171,7 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
     if (rc)
         return rc;
     n->used = 1;
-    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere"};
+    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder"};
     size_t kind = 0;
     while (kind < sizeof known / sizeof known[0] && strcmp(type, known[kind]))
         kind++;
@@ -212,8 +238,10 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         rc = rectangle(c, n->line, &mesh);
     else if (!strcmp(type, "cube"))
         rc = cube(c, n->line, &mesh);
-    else
+    else if (!strcmp(type, "disk"))
         rc = disk(c, n->line, &mesh);
+    else
+        rc = cylinder(c, n, &mesh, &m);
     if (!rc) {
         if (flip && mesh.nrm)
             for (size_t i = 0; i < 3 * (size_t)mesh.nverts; i++)

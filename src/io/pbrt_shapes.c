@@ -1,5 +1,6 @@
 /* pbrt shapes: triangle, bilinear-patch and PLY meshes, spheres (analytic
- * under similarity transforms, tessellated otherwise), and flattened object
+ * under similarity transforms, tessellated otherwise), disks and cylinders
+ * (tessellated), and flattened object
  * instances. Orientation follows pbrt-v3 exactly, since area lights emit
  * from the front face only: a triangle's normal is cross(p0 - p2, p1 - p2)
  * (= the CCW normal), turned towards the shading normals when the mesh has
@@ -169,6 +170,56 @@ static int read_sphere(cdl_pbrt_ctx *c, cdl_pbrt_shape *sh)
     return 0;
 }
 
+#define ROUND_SEGMENTS 128 /* segments of a disk's or cylinder's full turn */
+
+/* phimax in degrees, as pbrt reads it: clamped to [0, 360] */
+static int read_phimax(cdl_pbrt_ctx *c, double *phimax, int *nseg)
+{
+    int rc = cdl_pbrt_get_float(&c->ps, "phimax", 360.0, phimax, c->err);
+    if (rc)
+        return rc;
+    if (!(*phimax > 0.0))
+        return cdl_pbrt_error(c, c->line, "phimax %g must be > 0 degrees", *phimax);
+    *phimax = *phimax > 360.0 ? 360.0 : *phimax;
+    *nseg = (int)ceil(ROUND_SEGMENTS * *phimax / 360.0);
+    *nseg = *nseg < 1 ? 1 : *nseg;
+    *phimax *= 3.14159265358979323846 / 180.0;
+    return 0;
+}
+
+static int read_disk(cdl_pbrt_ctx *c, cdl_mesh *m)
+{
+    double h, r, ri, phimax;
+    int nseg = 1, rc;
+    if ((rc = cdl_pbrt_get_float(&c->ps, "height", 0.0, &h, c->err)) ||
+        (rc = cdl_pbrt_get_float(&c->ps, "radius", 1.0, &r, c->err)) ||
+        (rc = cdl_pbrt_get_float(&c->ps, "innerradius", 0.0, &ri, c->err)) || (rc = read_phimax(c, &phimax, &nseg)))
+        return rc;
+    if (!(r > 0.0 && r <= CDL_MAX_COORD && ri >= 0.0 && ri < r && fabs(h) <= CDL_MAX_COORD))
+        return cdl_pbrt_error(c, c->line, "disk radius %g, innerradius %g, height %g: need 0 <= innerradius < radius",
+                              r, ri, h);
+    return cdl_mesh_disk(m, h, r, ri, phimax, nseg, c->file, c->line, c->err);
+}
+
+static int read_cylinder(cdl_pbrt_ctx *c, cdl_mesh *m)
+{
+    double r, zmin, zmax, phimax;
+    int nseg = 1, rc;
+    if ((rc = cdl_pbrt_get_float(&c->ps, "radius", 1.0, &r, c->err)) ||
+        (rc = cdl_pbrt_get_float(&c->ps, "zmin", -1.0, &zmin, c->err)) ||
+        (rc = cdl_pbrt_get_float(&c->ps, "zmax", 1.0, &zmax, c->err)) || (rc = read_phimax(c, &phimax, &nseg)))
+        return rc;
+    if (zmin > zmax) { /* pbrt swaps them */
+        double t = zmin;
+        zmin = zmax;
+        zmax = t;
+    }
+    if (!(r > 0.0 && r <= CDL_MAX_COORD && zmax > zmin && fabs(zmin) <= CDL_MAX_COORD && fabs(zmax) <= CDL_MAX_COORD))
+        return cdl_pbrt_error(c, c->line, "cylinder radius %g, zmin %g, zmax %g: need radius > 0 and zmin != zmax", r,
+                              zmin, zmax);
+    return cdl_mesh_cylinder(m, r, zmin, zmax, phimax, nseg, c->file, c->line, c->err);
+}
+
 int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
 {
     cdl_pbrt_shape sh;
@@ -182,6 +233,10 @@ int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
         rc = read_ply(c, &sh.mesh);
     else if (!strcmp(type, "sphere"))
         rc = read_sphere(c, &sh);
+    else if (!strcmp(type, "disk"))
+        rc = read_disk(c, &sh.mesh);
+    else if (!strcmp(type, "cylinder"))
+        rc = read_cylinder(c, &sh.mesh);
     else {
         cdl_pbrt_warn(c, c->line, "Shape \"%s\" is not supported (skipped)", type);
         for (size_t i = 0; i < c->ps.n; i++)

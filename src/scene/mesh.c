@@ -75,6 +75,67 @@ int cdl_mesh_sphere(cdl_mesh *m, double r, int flip, const char *file, int line,
     return 0;
 }
 
+int cdl_mesh_disk(cdl_mesh *m, double h, double r, double ri, double phimax, int nseg, const char *file, int line,
+                  cdl_error *err)
+{
+    int ring = ri > 0.0, nv = (nseg + 1) * (ring ? 2 : 1) + !ring;
+    int rc = cdl_mesh_alloc(m, (uint32_t)nv, (uint32_t)(nseg * (ring ? 2 : 1)), 0, 1, file, line, err);
+    if (rc)
+        return rc;
+    /* outer ring, then the inner ring or the centre; pbrt's (u, v) =
+     * (phi / phimax, (r - rho) / (r - ri)) */
+    for (int k = 0; k <= (ring ? 1 : 0); k++)
+        for (int i = 0; i <= nseg; i++) {
+            double ph = phimax * i / nseg, rho = k ? ri : r;
+            int v = k * (nseg + 1) + i;
+            m->pos[3 * v] = (float)(rho * cos(ph));
+            m->pos[3 * v + 1] = (float)(rho * sin(ph));
+            m->pos[3 * v + 2] = (float)h;
+            m->uv[2 * v] = (float)i / (float)nseg;
+            m->uv[2 * v + 1] = k ? 1.0f : 0.0f;
+        }
+    uint32_t c = (uint32_t)(nseg + 1), *t = m->idx;
+    if (!ring) {
+        m->pos[3 * c] = m->pos[3 * c + 1] = 0.0f;
+        m->pos[3 * c + 2] = (float)h;
+        m->uv[2 * c] = 0.0f;
+        m->uv[2 * c + 1] = 1.0f;
+    }
+    for (uint32_t i = 0; i < (uint32_t)nseg; i++) { /* counter-clockwise seen from +z */
+        if (!ring) {
+            *t++ = c, *t++ = i, *t++ = i + 1;
+        } else {
+            *t++ = i, *t++ = i + 1, *t++ = c + i + 1;
+            *t++ = i, *t++ = c + i + 1, *t++ = c + i;
+        }
+    }
+    return 0;
+}
+
+int cdl_mesh_cylinder(cdl_mesh *m, double r, double zmin, double zmax, double phimax, int nseg, const char *file,
+                      int line, cdl_error *err)
+{
+    int rc = cdl_mesh_alloc(m, (uint32_t)(2 * (nseg + 1)), (uint32_t)(2 * nseg), 0, 1, file, line, err);
+    if (rc)
+        return rc;
+    for (int k = 0; k < 2; k++)
+        for (int i = 0; i <= nseg; i++) {
+            double ph = phimax * i / nseg;
+            int v = k * (nseg + 1) + i;
+            m->pos[3 * v] = (float)(r * cos(ph));
+            m->pos[3 * v + 1] = (float)(r * sin(ph));
+            m->pos[3 * v + 2] = (float)(k ? zmax : zmin);
+            m->uv[2 * v] = (float)i / (float)nseg; /* pbrt's (phi / phimax, (z - zmin) / (zmax - zmin)) */
+            m->uv[2 * v + 1] = (float)k;
+        }
+    uint32_t c = (uint32_t)(nseg + 1), *t = m->idx;
+    for (uint32_t i = 0; i < (uint32_t)nseg; i++) { /* counter-clockwise seen from outside */
+        *t++ = i, *t++ = i + 1, *t++ = c + i + 1;
+        *t++ = i, *t++ = c + i + 1, *t++ = c + i;
+    }
+    return 0;
+}
+
 static int same_point(const float *a, const float *b)
 {
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];

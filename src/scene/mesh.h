@@ -28,6 +28,16 @@ void cdl_mesh_free(cdl_mesh *m);
  * flip), pbrt's (u, v): for spheres a transform cannot keep analytic. */
 int cdl_mesh_sphere(cdl_mesh *m, double r, int flip, const char *file, int line, cdl_error *err);
 
+/* pbrt's disk (an annulus of radii ri < r at z = h, up to angle phimax in
+ * radians) and cylinder (radius r from zmin to zmax) as nseg-segment
+ * meshes without shading normals: a disk faces +z, a cylinder outwards
+ * (counter-clockwise), so cdl_scene_add_mesh's rule orients them as pbrt
+ * does; pbrt's (u, v). */
+int cdl_mesh_disk(cdl_mesh *m, double h, double r, double ri, double phimax, int nseg, const char *file, int line,
+                  cdl_error *err);
+int cdl_mesh_cylinder(cdl_mesh *m, double r, double zmin, double zmax, double phimax, int nseg, const char *file,
+                      int line, cdl_error *err);
+
 /* Adds m transformed by xf with pbrt-v3's orientation rule: a triangle
  * faces its shading normals when the mesh has them, otherwise its CCW
  * normal flipped by reverse XOR a handedness-swapping xf. Errors (a
