@@ -242,6 +242,37 @@ static void spectra(void)
     cdl_scene_free(&s);
 }
 
+/* Ids at any depth: a bsdf (and a texture) declared inside another
+ * element is known from there on, as Mitsuba knows it. */
+static void nested_ids(void)
+{
+    write_file("ids.xml",
+               "<scene version=\"3.0.0\">\n" LIGHT
+               "<shape type=\"rectangle\"><bsdf type=\"twosided\"><bsdf type=\"diffuse\" id=\"inner\">"
+               "<rgb name=\"reflectance\" value=\"0.1, 0.2, 0.3\"/></bsdf></bsdf></shape>\n"
+               "<shape type=\"cube\"><ref id=\"inner\"/></shape>\n"
+               "<bsdf type=\"diffuse\" id=\"textured\"><texture type=\"bitmap\" name=\"reflectance\" id=\"tex\">"
+               "<string name=\"filename\" value=\"px.png\"/></texture></bsdf>\n"
+               "<bsdf type=\"diffuse\" id=\"again\"><ref name=\"reflectance\" id=\"tex\"/></bsdf>\n"
+               "</scene>\n");
+    float px[3] = {0.25f, 0.5f, 0.75f};
+    cdl_image img = {1, 1, px};
+    char path[512];
+    snprintf(path, sizeof path, "%s/px.png", dir);
+    cdl_error err;
+    die_on(cdl_image_write(path, &img, NULL, 0, 0.0f, &err), &err);
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("ids.xml", &s, &set)) {
+        CHECK(0, "ids.xml loads (a nested id referred to later)");
+        return;
+    }
+    uint32_t rect = s.tri_mat[0], cube = s.tri_mat[2];
+    CHECK(rect == cube && near3(s.mats[cube].kd, cdl_v3(0.1f, 0.2f, 0.3f), 1e-6f),
+          "the cube's <ref id=\"inner\"> is the rectangle's nested bsdf (materials %u, %u)", rect, cube);
+    cdl_scene_free(&s);
+}
+
 /* A cylinder from p0 to p1 (along x) of radius 0.5: its area and normals
  * outwards, inwards with flip_normals. */
 static void cylinder(void)
@@ -417,6 +448,7 @@ int main(int argc, char **argv)
     search_paths();
     spectra();
     cylinder();
+    nested_ids();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

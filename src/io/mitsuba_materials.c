@@ -49,6 +49,20 @@ static int ior_prop(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, double de
 }
 
 /* A color property that may be a texture (tex != NULL) or must be constant. */
+/* An id on a bsdf or texture declared inside another element: Mitsuba
+ * knows it from there on, as one declared at the top. */
+static int nested_id(cdl_mts_ctx *c, const cdl_xml_node *n, cdl_mts_kind kind, int32_t mat, int tex, cdl_vec3 value)
+{
+    int rc = 0;
+    const char *id = cdl_mts_attr(c, n, "id", &rc);
+    if (rc || !id || !*id)
+        return rc;
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", id);
+    cdl_mts_id v = {buf, kind, mat, tex, value};
+    return cdl_mts_add_id(c, n, &v);
+}
+
 static int color(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex)
 {
     cdl_xml_node *p = cdl_mts_prop(c, n, name);
@@ -73,6 +87,8 @@ static int color(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def
         v = d->value;
     } else if (!strcmp(p->name, "texture")) {
         rc = cdl_mts_texture(c, p, &t, &v);
+        if (!rc)
+            rc = nested_id(c, p, CDL_MTS_TEXTURE, -1, t, v);
     } else {
         rc = cdl_mts_color_node(c, p, &v);
     }
@@ -163,7 +179,8 @@ int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat
         if (!strcmp(k->name, "bsdf")) {
             k->used = 1;
             *found = 1;
-            return cdl_mts_bsdf(c, k, mat);
+            int rc = cdl_mts_bsdf(c, k, mat);
+            return rc ? rc : nested_id(c, k, CDL_MTS_BSDF, *mat, -1, cdl_v3(0, 0, 0));
         }
         if (!strcmp(k->name, "ref")) {
             int rc = 0;
