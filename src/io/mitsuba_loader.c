@@ -124,8 +124,9 @@ static int sensor(cdl_mts_ctx *c, cdl_xml_node *n)
         fl = strtod(fs, NULL);
         if (!(fl > 0.0 && fl < 1e6))
             return cdl_mts_error(c, n->line, "focal_length \"%s\" must be a positive length in mm", fs);
-        fov = 2.0 * atan(36.0 / (2.0 * fl)) * 180.0 / PI; /* of a 36 mm film's width */
-        snprintf(axis, sizeof axis, "x");
+        /* across the diagonal of a 36 x 24 mm film, as Mitsuba 0.6 and 3 */
+        fov = 2.0 * atan(sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * fl)) * 180.0 / PI;
+        snprintf(axis, sizeof axis, "diagonal");
     }
     if (!(fov > 0.0 && fov < 180.0))
         return cdl_mts_error(c, n->line, "fov %g must be in (0, 180) degrees", fov);
@@ -163,7 +164,7 @@ static int integrator(cdl_mts_ctx *c, cdl_xml_node *n)
         return rc;
     static const char *const map[][2] = {{"path", "path"},         {"volpath", "path"}, {"volpath_simple", "path"},
                                          {"direct", "path"},       {"bdpt", "bdpt"},    {"photonmapper", "pm"},
-                                         {"sppm", "pm"},           {"ppm", "pm"}};
+                                         {"sppm", "pm"},           {"ppm", "pm"},       {"ptracer", "path"}};
     const char *ours = NULL;
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (!strcmp(type, map[i][0]))
