@@ -105,6 +105,31 @@ static void camera_and_transforms(void)
     CHECK(s.ntris == 2 && xmin == 8.0f && xmax == 12.0f, "scale 2 then translate 10: x in [%g, %g] (8, 12)",
           (double)xmin, (double)xmax);
     cdl_scene_free(&s);
+
+    /* -D w=64 (Mitsuba's command line) wins over the file's <default>s;
+     * the focal length's default of 50 mm spans the film's diagonal */
+    const char defs[2][CDL_DEFINE_LEN] = {"w=64", "unknown=1"};
+    char path[512];
+    snprintf(path, sizeof path, "%s/cam.xml", dir);
+    cdl_error err;
+    int rc = cdl_scene_init(&s, path, &err);
+    if (!rc)
+        rc = cdl_scene_load_defined(&s, path, defs, 2, &set, &err);
+    CHECK(!rc && set.width == 64, "define w=64: film width %d", set.width);
+    cdl_scene_free(&s);
+    write_file("focal.xml", "<scene version=\"3.0.0\"><sensor type=\"perspective\">\n"
+                            "<film type=\"hdrfilm\"><integer name=\"width\" value=\"300\"/>"
+                            "<integer name=\"height\" value=\"100\"/></film></sensor>\n" LIGHT
+                            "<shape type=\"sphere\"/></scene>\n");
+    if (!load("focal.xml", &s, &set)) {
+        double diag = 2.0 * atan(sqrt(36.0 * 36.0 + 24.0 * 24.0) / 100.0);
+        want = 2.0 * atan(tan(diag / 2.0) * 100.0 / sqrt(300.0 * 300.0 + 100.0 * 100.0)) * 180.0 / PI;
+        CHECK(fabs(set.fov - want) < 1e-4, "50 mm on 300 x 100: %.4f degrees on the short axis (%.4f)",
+              (double)set.fov, want);
+        cdl_scene_free(&s);
+    } else {
+        CHECK(0, "focal.xml loads");
+    }
 }
 
 /* Mitsuba 0.6 spelling (toWorld, intIOR, specularReflectance), include,

@@ -18,7 +18,8 @@ int cdl_scene_open(const char *path, const cdl_settings *settings, cdl_scene **o
     const cdl_log_sink *prev = cdl_log_push(settings ? &settings->sink : NULL);
     int rc = cdl_scene_init(s, path, err);
     if (!rc)
-        rc = cdl_scene_load(s, path, &s->settings, err);
+        rc = cdl_scene_load_defined(s, path, settings ? settings->c.defines : NULL, settings ? settings->c.ndefines : 0,
+                                    &s->settings, err);
     for (int i = 0; !rc && settings && i < settings->c.nlights; i++) {
         const float *l = settings->c.lights[i];
         rc = cdl_scene_add_point_light(s, cdl_v3(l[0], l[1], l[2]), cdl_v3(l[3], l[4], l[5]), err);

@@ -48,6 +48,8 @@ static const char *option_name(const char *o, char *buf, size_t n)
         return "integrator";
     if (!strcmp(o, "-q"))
         return "quiet";
+    if (!strcmp(o, "-D")) /* Mitsuba's spelling */
+        return "define";
     int single = o[0] == '-' && o[1] && !o[2]; /* -C, -S, -R */
     if (!single && strncmp(o, "--", 2))
         return NULL;

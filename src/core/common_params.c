@@ -9,6 +9,18 @@ static const char *nonneg_intensity(const double *v, int n)
     return n == 6 && (v[3] < 0.0 || v[4] < 0.0 || v[5] < 0.0) ? "intensity must not be negative" : NULL;
 }
 
+/* NAME=VALUE with a Mitsuba parameter name (letters, digits, _) */
+static const char *define_text(const char *v)
+{
+    const char *eq = strchr(v, '=');
+    if (!eq || eq == v)
+        return "expected NAME=VALUE";
+    for (const char *p = v; p < eq; p++)
+        if (!(*p == '_' || (*p >= '0' && *p <= '9') || (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z')))
+            return "a parameter name has letters, digits and _ only";
+    return NULL;
+}
+
 static const cdl_param rows[] = {
     {"integrator", CDL_PARAM_NAME, "NAME", "path", "light transport method (path, bdpt, ir, rigi, pm, gkde, splat)",
      .count = sizeof(((cdl_common_params *)0)->integrator), .at = offsetof(cdl_common_params, integrator)},
@@ -35,6 +47,10 @@ static const cdl_param rows[] = {
      .flags = CDL_PARAM_REPEAT, .count = 6, .repeat = CDL_MAX_POINT_LIGHTS,
      .at = offsetof(cdl_common_params, lights), .store = CDL_STORE_FLOAT,
      .count_at = offsetof(cdl_common_params, nlights)},
+    {"define", CDL_PARAM_NAME, "NAME=VALUE", "",
+     "set a Mitsuba scene's parameter (its <default name>, $NAME in the file), as mitsuba -D; repeatable",
+     .check_text = define_text, .flags = CDL_PARAM_REPEAT, .count = CDL_DEFINE_LEN, .repeat = CDL_MAX_DEFINES,
+     .at = offsetof(cdl_common_params, defines), .count_at = offsetof(cdl_common_params, ndefines)},
     {"exposure", CDL_PARAM_FLOAT, "EV", "0", "PNG exposure in stops", -100, 100, AT(exposure)},
     {"quiet", CDL_PARAM_BOOL, "", "off", "no warnings (and, in the command, no progress bar)",
      .flags = CDL_PARAM_FLAG, AT(quiet)},

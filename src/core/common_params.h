@@ -6,6 +6,8 @@
 #include "core/params.h"
 
 #define CDL_MAX_POINT_LIGHTS 64
+#define CDL_MAX_DEFINES 32
+#define CDL_DEFINE_LEN 256
 
 typedef struct cdl_common_params {
     char integrator[32];
@@ -19,6 +21,8 @@ typedef struct cdl_common_params {
     int sampler; /* cdl_sampler_kind */
     float lights[CDL_MAX_POINT_LIGHTS][6];
     int nlights;
+    char defines[CDL_MAX_DEFINES][CDL_DEFINE_LEN]; /* "name=value" for a Mitsuba file's <default>s */
+    int ndefines;
     double exposure;
     int quiet;
 } cdl_common_params;

@@ -240,13 +240,25 @@ int cdl_param_set(const cdl_param *p, const char *value, void *base, cdl_error *
         }
         return 0;
     }
-    case CDL_PARAM_NAME:
+    case CDL_PARAM_NAME: {
         if (!value[0] || strlen(value) >= (size_t)p->count)
             return cdl_error_set(err, CDL_ERR_USAGE, p->name, 0, "expected a name of 1 to %d characters, got '%s'",
                                  p->count - 1, value);
-        if (base)
-            memcpy((char *)base + p->at, value, strlen(value) + 1);
+        const char *why = p->check_text ? p->check_text(value) : NULL;
+        if (why)
+            return cdl_error_set(err, CDL_ERR_USAGE, p->name, 0, "%s, got '%s'", why, value);
+        if (!base)
+            return 0;
+        size_t at = p->at;
+        if (p->flags & CDL_PARAM_REPEAT) {
+            int *cnt = (int *)((char *)base + p->count_at);
+            if (*cnt >= p->repeat)
+                return cdl_error_set(err, CDL_ERR_USAGE, p->name, 0, "given more than %d times", p->repeat);
+            at += (size_t)(*cnt)++ * (size_t)p->count;
+        }
+        memcpy((char *)base + at, value, strlen(value) + 1);
         return 0;
+    }
     }
     if (base)
         store(base, p->at, p->store, v);

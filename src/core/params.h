@@ -54,6 +54,8 @@ typedef struct cdl_param {
     const char *note;    /* said when a value is out of range (why the range is what it is) */
     /* FLOATS: a check on the values together; returns the problem or NULL */
     const char *(*check)(const double *v, int n);
+    /* NAME: a check on the text; returns the problem or NULL */
+    const char *(*check_text)(const char *v);
     int flags;
     int count;           /* FLOATS: values per setting; RES: 2; NAME: the buffer's size */
     int repeat;          /* REPEAT: most settings */

@@ -60,17 +60,40 @@ int cdl_mts_same_name(const char *a, const char *b)
     return !strcmp(fa, fb);
 }
 
-static const char *var_get(const cdl_mts_ctx *c, const char *name, size_t len)
+static cdl_mts_var *var_get(const cdl_mts_ctx *c, const char *name, size_t len)
 {
     for (int i = 0; i < c->nvars; i++)
         if (strlen(c->vars[i].name) == len && !strncmp(c->vars[i].name, name, len))
-            return c->vars[i].value;
+            return &c->vars[i];
     return NULL;
 }
 
 static int oom(cdl_mts_ctx *c)
 {
     return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, 0, "out of memory");
+}
+
+int cdl_mts_define(cdl_mts_ctx *c, const char *name, size_t len, const char *value, int given)
+{
+    if (var_get(c, name, len))
+        return 0; /* the first definition holds: -D before the file's <default> */
+    if (c->nvars == c->capvars) {
+        int cap = c->capvars ? 2 * c->capvars : 8;
+        cdl_mts_var *v = realloc(c->vars, sizeof *v * (size_t)cap);
+        if (!v)
+            return oom(c);
+        c->vars = v;
+        c->capvars = cap;
+    }
+    cdl_mts_var *v = &c->vars[c->nvars];
+    *v = (cdl_mts_var){.name = strndup(name, len), .value = strdup(value), .given = given};
+    if (!v->name || !v->value) {
+        free(v->name);
+        free(v->value);
+        return oom(c);
+    }
+    c->nvars++;
+    return 0;
 }
 
 /* <default name value>: defines name unless it is defined already. */
@@ -84,26 +107,12 @@ int cdl_mts_default(cdl_mts_ctx *c, const cdl_xml_node *n)
     for (const char *p = name; *p; p++)
         if (!isalnum((unsigned char)*p) && *p != '_')
             return cdl_mts_error(c, n->line, "<default>: \"%s\" is not a parameter name (letters, digits, _)", name);
-    if (var_get(c, name, strlen(name)))
+    cdl_mts_var *v = var_get(c, name, strlen(name));
+    if (v) {
+        v->used = 1; /* declared: a -D of it is not unknown */
         return 0;
-    if (c->nvars == c->capvars) {
-        int cap = c->capvars ? 2 * c->capvars : 8;
-        cdl_mts_var *v = realloc(c->vars, sizeof *v * (size_t)cap);
-        if (!v)
-            return oom(c);
-        c->vars = v;
-        c->capvars = cap;
     }
-    cdl_mts_var *v = &c->vars[c->nvars];
-    v->name = strdup(name);
-    v->value = strdup(value);
-    if (!v->name || !v->value) {
-        free(v->name);
-        free(v->value);
-        return oom(c);
-    }
-    c->nvars++;
-    return 0;
+    return cdl_mts_define(c, name, strlen(name), value, 0);
 }
 
 const char *cdl_mts_attr(cdl_mts_ctx *c, const cdl_xml_node *n, const char *attr, int *rc)
@@ -119,7 +128,10 @@ const char *cdl_mts_attr(cdl_mts_ctx *c, const cdl_xml_node *n, const char *attr
             const char *q = p + 1;
             while (isalnum((unsigned char)*q) || *q == '_')
                 q++;
-            add = var_get(c, p + 1, (size_t)(q - p - 1));
+            cdl_mts_var *var = var_get(c, p + 1, (size_t)(q - p - 1));
+            add = var ? var->value : NULL;
+            if (var)
+                var->used = 1;
             if (!add) {
                 *rc = cdl_mts_error(c, n->line, "%s=\"%s\": parameter $%.*s is not defined (no <default>)", attr, v,
                                     (int)(q - p - 1), p + 1);

@@ -32,6 +32,8 @@ typedef struct cdl_mts_id {
 
 typedef struct cdl_mts_var {
     char *name, *value;
+    int given; /* from the command line (-D), not a <default> */
+    int used;  /* a $name referred to it */
 } cdl_mts_var;
 
 #define CDL_MTS_MAX_PATHS 16
@@ -92,6 +94,8 @@ int cdl_mts_transform(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_mat
 int cdl_mts_add_id(cdl_mts_ctx *c, const cdl_xml_node *n, const cdl_mts_id *v);
 /* <default name value>: defines name unless it is defined already. */
 int cdl_mts_default(cdl_mts_ctx *c, const cdl_xml_node *n);
+/* Defines $name (name[0..len)) unless it is: given = from the command line. */
+int cdl_mts_define(cdl_mts_ctx *c, const char *name, size_t len, const char *value, int given);
 /* <path value>: a folder (relative to the file it is in) searched for
  * relative file names before the main file's folder, as Mitsuba's file
  * resolver does. */

@@ -295,7 +295,8 @@ static int read_file(cdl_mts_ctx *c, const char *path, int line)
     return rc;
 }
 
-int cdl_load_mitsuba(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_error *err)
+int cdl_load_mitsuba(cdl_scene *s, const char *path, const char (*defs)[CDL_DEFINE_LEN], int ndefs,
+                     cdl_scene_settings *set, cdl_error *err)
 {
     cdl_scene_settings dummy;
     if (!set) {
@@ -316,7 +317,19 @@ int cdl_load_mitsuba(cdl_scene *s, const char *path, cdl_scene_settings *set, cd
     set->width = 768;
     set->height = 576;
     set->spp = 4;
-    int rc = read_file(c, path, 0);
+    int rc = 0;
+    for (int i = 0; i < ndefs && !rc; i++) {
+        const char *eq = strchr(defs[i], '=');
+        if (!eq || eq == defs[i])
+            rc = cdl_error_set(err, CDL_ERR_USAGE, "define", 0, "expected NAME=VALUE, got '%s'", defs[i]);
+        else
+            rc = cdl_mts_define(c, defs[i], (size_t)(eq - defs[i]), eq + 1, 1);
+    }
+    if (!rc)
+        rc = read_file(c, path, 0);
+    for (int i = 0; !rc && i < c->nvars; i++)
+        if (c->vars[i].given && !c->vars[i].used)
+            cdl_warn(path, 0, "define \"%s\": the scene has no such parameter (ignored)", c->vars[i].name);
     if (!rc && !c->saw_sensor) {
         set->has_camera = 1; /* at the origin, looking down +z, 45 degrees along x */
         set->eye = cdl_v3(0, 0, 0);
