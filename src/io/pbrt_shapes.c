@@ -14,6 +14,7 @@
 
 #include "io/pbrt_internal.h"
 #include "scene/mesh.h"
+#include "scene/subdiv.h"
 #include "io/ply.h"
 
 
@@ -31,10 +32,9 @@ static int oom(cdl_pbrt_ctx *c)
 /* trianglemesh (quads = 0) or pbrt-v4 bilinearmesh (quads = 1, split
  * into two triangles (p00, p10, p11), (p00, p11, p01) that keep the
  * patch's normal cross(dp/du, dp/dv)). */
-static int read_mesh(cdl_pbrt_ctx *c, int quads, cdl_mesh *m)
+static int read_mesh(cdl_pbrt_ctx *c, int quads, const char *what, cdl_mesh *m)
 {
     cdl_pbrt_params *ps = &c->ps;
-    const char *what = quads ? "bilinearmesh" : "trianglemesh";
     size_t per = quads ? 4 : 3;
     cdl_pbrt_param *P = cdl_pbrt_find(ps, "P"), *I = cdl_pbrt_find(ps, "indices");
     cdl_pbrt_param *N = cdl_pbrt_find(ps, "N"), *UV = cdl_pbrt_find(ps, "uv");
@@ -220,15 +220,36 @@ static int read_cylinder(cdl_pbrt_ctx *c, cdl_mesh *m)
     return cdl_mesh_cylinder(m, r, zmin, zmax, phimax, nseg, c->file, c->line, c->err);
 }
 
+/* pbrt's loopsubdiv: a triangle mesh subdivided "levels" times (3 by
+ * default) to its limit surface. */
+static int read_loopsubdiv(cdl_pbrt_ctx *c, cdl_mesh *m)
+{
+    int levels;
+    int rc = cdl_pbrt_get_int(&c->ps, "levels", 3, &levels, c->err);
+    if (!rc && cdl_pbrt_find(&c->ps, "nlevels")) /* pbrt-v2's name */
+        rc = cdl_pbrt_get_int(&c->ps, "nlevels", 3, &levels, c->err);
+    if (rc)
+        return rc;
+    if (levels < 0 || levels > 12)
+        return cdl_pbrt_error(c, c->line, "loopsubdiv: levels %d must be in 0..12", levels);
+    if ((rc = read_mesh(c, 0, "loopsubdiv", m)))
+        return rc;
+    if (m->nrm || m->uv)
+        cdl_pbrt_warn(c, c->line, "loopsubdiv: N and uv are not subdivided (the limit surface's normals are used)");
+    return cdl_mesh_loop_subdivide(m, levels, c->file, c->line, c->err);
+}
+
 int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
 {
     cdl_pbrt_shape sh;
     memset(&sh, 0, sizeof sh);
     int rc;
     if (!strcmp(type, "trianglemesh"))
-        rc = read_mesh(c, 0, &sh.mesh);
+        rc = read_mesh(c, 0, type, &sh.mesh);
     else if (!strcmp(type, "bilinearmesh"))
-        rc = read_mesh(c, 1, &sh.mesh);
+        rc = read_mesh(c, 1, type, &sh.mesh);
+    else if (!strcmp(type, "loopsubdiv"))
+        rc = read_loopsubdiv(c, &sh.mesh);
     else if (!strcmp(type, "plymesh"))
         rc = read_ply(c, &sh.mesh);
     else if (!strcmp(type, "sphere"))
