@@ -27,6 +27,8 @@ import numpy as np
 import OpenImageIO as oiio
 
 PASSING = [
+    "bsdf_spheres/test_constant_path.xml",
+    "bsdf_spheres/test_pointlight_path.xml",
     "floating_sphere/test_directional_direct.xml",
 ]
 

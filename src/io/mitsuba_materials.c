@@ -1,7 +1,9 @@
 /* Mitsuba bsdfs, textures and emitters as candela's materials and lights.
  * Defaults are Mitsuba 3's; what candela has no model for is approximated
- * with a warning (roughness distributions are all GGX, plastic is pbrt's
- * plastic, wavelength spectra are greys). */
+ * with a warning (wavelength spectra are greys). Plastic and roughplastic
+ * are Mitsuba's own coated model (scene/plastic.h); they and the rough
+ * conductors use Mitsuba's microfacet model (scene/microfacet_mts.h);
+ * rough dielectrics are pbrt's GGX whatever the distribution says. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -10,6 +12,8 @@
 
 #include "io/mitsuba_internal.h"
 #include "io/pbrt_params.h"
+#include "scene/microfacet_mts.h"
+#include "scene/plastic.h"
 #include "scene/scene.h"
 
 /* Mitsuba's named indices of refraction (its ior.h table). */
@@ -154,9 +158,14 @@ static int roughness(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
         return cdl_mts_error(c, n->line, "alpha (%g, %g) must be in [0, 10]", au, av);
     if (rough && strcmp(dist, "ggx") && strcmp(dist, "beckmann") && strcmp(dist, "phong"))
         return cdl_mts_error(c, n->line, "distribution \"%s\" must be ggx, beckmann or phong", dist);
+    /* sampling only: candela always samples the visible normals, which
+     * changes the noise, not the image */
     cdl_mts_prop(c, n, "sample_visible");
     m->alpha_x = (float)au;
     m->alpha_y = (float)av;
+    m->mf = strcmp(dist, "ggx") ? CDL_MF_BECKMANN : CDL_MF_GGX;
+    if (rough && !strcmp(dist, "phong"))
+        cdl_mts_warn(c, n->line, "distribution \"phong\" (Mitsuba 0.6) read as beckmann");
     return 0;
 }
 
@@ -244,6 +253,87 @@ static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
         (rc = roughness(c, n, rough, m)))
         return rc;
     m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
+    if (!rough)
+        m->mf = CDL_MF_PBRT; /* a mirror (alpha 0) */
+    return 0;
+}
+
+/* Mitsuba's Texture::mean(): the channels' mean of a constant, the mean
+ * luminance of a bitmap (times candela's constant factor). */
+static float texture_mean(cdl_mts_ctx *c, cdl_vec3 v, int tex)
+{
+    float k = (v.x + v.y + v.z) / 3.0f;
+    if (tex < 0 || tex >= (int)c->s->ntexs)
+        return k;
+    const cdl_texture *t = &c->s->texs[tex];
+    double sum = 0.0;
+    size_t np = (size_t)t->w * (size_t)t->h;
+    for (size_t i = 0; i < np; i++)
+        sum += cdl_luminance(cdl_v3(t->rgb[3 * i], t->rgb[3 * i + 1], t->rgb[3 * i + 2]));
+    return np ? k * (float)(sum / (double)np) : k;
+}
+
+static int plastic(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m)
+{
+    *m = cdl_material_default(rough ? CDL_MAT_ROUGH_COATED : CDL_MAT_COATED);
+    cdl_xml_node *ksn = cdl_mts_prop(c, n, "specular_reflectance");
+    int rc, ks_given = ksn != NULL;
+    if (ksn)
+        ksn->used = 0; /* read below */
+    if ((rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)) ||
+        (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
+        (rc = rel_ior(c, n, 1.49, &m->eta)) || (rc = roughness(c, n, rough, m)) ||
+        (rc = cdl_mts_bool(c, n, "nonlinear", 0, &m->nonlinear)))
+        return rc;
+    m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
+    m->kd = at_most_one(c, n->line, "diffuse reflectance", m->kd);
+    if (fabsf(m->eta - 1.0f) < 1e-6f)
+        return cdl_mts_error(c, n->line, "bsdf \"%s\": int_ior and ext_ior must differ", rough ? "roughplastic" : "plastic");
+    if (rough && m->alpha_x != m->alpha_y)
+        return cdl_mts_error(c, n->line, "bsdf \"roughplastic\": anisotropic roughness is not supported (nor by Mitsuba)");
+    float d = texture_mean(c, m->kd, m->kd_tex), sm = ks_given ? (m->ks.x + m->ks.y + m->ks.z) / 3.0f : 1.0f;
+    m->spec_weight = d + sm > 0.0f ? sm / (d + sm) : 0.5f;
+    cdl_coat_prepare(m);
+    return 0;
+}
+
+/* mask: the nested material (a copy) with an opacity, a constant or the
+ * luminance of a texture. */
+static int mask(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    cdl_vec3 v;
+    int tex, rc, found;
+    int32_t inner;
+    if ((rc = color(c, n, "opacity", cdl_v3(0.5f, 0.5f, 0.5f), &v, &tex)) ||
+        (rc = cdl_mts_child_bsdf(c, n, 0, &inner, &found)))
+        return rc;
+    if (!found)
+        return cdl_mts_error(c, n->line, "bsdf \"mask\" needs a nested <bsdf> or <ref>");
+    if (inner < 0) { /* a null bsdf stays invisible */
+        *mat = inner;
+        return 0;
+    }
+    cdl_material m = c->s->mats[inner];
+    float op = cdl_luminance(v);
+    if (m.masked && m.opacity_tex >= 0 && tex >= 0) {
+        cdl_mts_warn(c, n->line, "bsdf \"mask\" inside a textured mask: the inner texture is used, this one's scale only");
+        tex = m.opacity_tex;
+    }
+    if (m.masked) {
+        op *= m.opacity;
+        if (tex < 0)
+            tex = m.opacity_tex;
+    }
+    m.masked = 1;
+    m.opacity = cdl_minf(1.0f, op);
+    m.opacity_tex = tex;
+    const char *id = cdl_xml_attr_get(n, "id");
+    snprintf(m.name, sizeof m.name, "%.63s", id ? id : "mask");
+    cdl_mts_warn_unused(c, n, "mask");
+    uint32_t idx;
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+        return rc;
+    *mat = (int32_t)idx;
     return 0;
 }
 
@@ -255,7 +345,9 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         return rc;
     n->used = 1;
     /* wrappers: the surface is the nested bsdf's */
-    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "mask", "blendbsdf", "coating",
+    if (!strcmp(type, "mask"))
+        return mask(c, n, mat);
+    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "blendbsdf", "coating",
                                        "roughcoating"};
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
         if (!strcmp(type, wrap[i])) {
@@ -282,13 +374,7 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             cdl_mts_prop(c, n, "use_fast_approx");
         }
     } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
-        m = cdl_material_default(CDL_MAT_PLASTIC);
-        int nonlinear;
-        if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
-            !(rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
-            !(rc = rel_ior(c, n, 1.49, &m.eta)) && !(rc = roughness(c, n, rough, &m)))
-            rc = cdl_mts_bool(c, n, "nonlinear", 0, &nonlinear);
-        m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
+        rc = plastic(c, n, rough, &m);
     } else if (!strcmp(type, "conductor") || !strcmp(type, "roughconductor")) {
         rc = conductor(c, n, rough, &m);
     } else if (!strcmp(type, "dielectric") || !strcmp(type, "roughdielectric") || !strcmp(type, "thindielectric")) {
@@ -301,6 +387,9 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             rc = roughness(c, n, rough, &m);
         m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
         m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
+        if (!rc && rough && m.mf == CDL_MF_BECKMANN)
+            cdl_mts_warn(c, n->line, "bsdf \"roughdielectric\": distribution beckmann approximated by GGX");
+        m.mf = CDL_MF_PBRT;
     } else if (!strcmp(type, "phong")) {
         double e = 30.0;
         m = cdl_material_default(CDL_MAT_PHONG);
@@ -338,7 +427,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     }
     if (rc)
         return rc;
-    if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_PLASTIC || m.type == CDL_MAT_PHONG)
+    if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_COATED || m.type == CDL_MAT_ROUGH_COATED ||
+        m.type == CDL_MAT_PHONG)
         m.kd = at_most_one(c, n->line, "diffuse reflectance", m.kd);
     const char *id = cdl_xml_attr_get(n, "id");
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : type);
