@@ -51,6 +51,8 @@ void cdl_coat_prepare(cdl_material *m)
     }
     cdl_mf d = cdl_mf_make((cdl_mf_type)m->mf, m->alpha_x, m->alpha_x);
     double ri = 0.0;
+    /* 64 x 17k visible normals: on every core, a large scene has many */
+#pragma omp parallel for reduction(+ : ri) schedule(dynamic)
     for (int k = 0; k < CDL_COAT_RES; k++) {
         float mu = cdl_maxf(1e-6f, (float)k / (CDL_COAT_RES - 1));
         cdl_vec3 wi = cdl_v3(sqrtf(1.0f - mu * mu), 0.0f, mu);
