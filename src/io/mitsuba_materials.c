@@ -369,9 +369,20 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         m = cdl_material_default(CDL_MAT_DIFFUSE);
         rc = color(c, n, "reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
         if (!rc && type[0] == 'r') {
-            cdl_mts_warn(c, n->line, "bsdf \"roughdiffuse\": Oren-Nayar approximated by Lambert");
-            cdl_mts_prop(c, n, "alpha");
-            cdl_mts_prop(c, n, "use_fast_approx");
+            /* Mitsuba 0.6: sigma = alpha / sqrt(2), the full model unless
+             * use_fast_approx */
+            double alpha;
+            int fast;
+            if (!cdl_mts_prop(c, n, "reflectance") && cdl_mts_prop(c, n, "diffuse_reflectance"))
+                rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
+            if (!rc && !(rc = cdl_mts_float(c, n, "alpha", 0.2, &alpha)) &&
+                !(rc = cdl_mts_bool(c, n, "use_fast_approx", 0, &fast))) {
+                if (!(alpha >= 0.0 && alpha <= 10.0))
+                    return cdl_mts_error(c, n->line, "roughdiffuse alpha %g must be in [0, 10]", alpha);
+                m.type = CDL_MAT_ROUGH_DIFFUSE;
+                m.sigma = (float)(alpha / sqrt(2.0));
+                m.on_full = !fast;
+            }
         }
     } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
         rc = plastic(c, n, rough, &m);

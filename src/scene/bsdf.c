@@ -2,6 +2,7 @@
 
 #include "core/sampling.h"
 #include "scene/microfacet.h"
+#include "scene/oren_nayar.h"
 #include "scene/microfacet_mts.h"
 #include "scene/plastic.h"
 
@@ -21,6 +22,8 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->nonlinear = m->nonlinear;
     b->spec_weight = m->spec_weight;
     b->coat_ri = m->coat_ri;
+    b->sigma = m->sigma;
+    b->on_full = m->on_full;
     b->coat_t = m->coat_t;
     b->opacity = m->masked ? cdl_minf(1.0f, cdl_maxf(0.0f, m->opacity)) : 1.0f;
     /* below ~1e-4 the GGX lobe underflows in float */
@@ -62,7 +65,8 @@ float cdl_fresnel_dielectric(float cos_i, float eta)
 static int is_opaque(const cdl_bsdf *b)
 {
     return b->type == CDL_MAT_DIFFUSE || b->type == CDL_MAT_PHONG || b->type == CDL_MAT_CONDUCTOR ||
-           b->type == CDL_MAT_PLASTIC || b->type == CDL_MAT_COATED || b->type == CDL_MAT_ROUGH_COATED;
+           b->type == CDL_MAT_PLASTIC || b->type == CDL_MAT_COATED || b->type == CDL_MAT_ROUGH_COATED ||
+           b->type == CDL_MAT_ROUGH_DIFFUSE;
 }
 
 /* Opaque materials are two-sided: both directions are mirrored to the
@@ -126,6 +130,9 @@ static cdl_vec3 opaque_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *
     float pd = li.z * CDL_INV_PI, ps, cos_h;
     cdl_vec3 f = cdl_scale(b->kd, CDL_INV_PI);
     switch (b->type) {
+    case CDL_MAT_ROUGH_DIFFUSE: /* sampled as Lambert: by the cosine */
+        *pdf = pd;
+        return cdl_oren_nayar(b->kd, b->sigma, b->on_full, lo, li);
     case CDL_MAT_PHONG:
         f = cdl_madd(f, b->ks, phong_lobe(b->ns, lo, li, &ps));
         *pdf = (1.0f - b->p_spec) * pd + b->p_spec * ps;

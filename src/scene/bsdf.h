@@ -18,6 +18,8 @@ typedef struct cdl_bsdf {
     int fresnel;     /* mirror: ks times the conductor Fresnel term of eta3, k3 */
     int mf, nonlinear;           /* coated (plastic.h) */
     float spec_weight, coat_ri;
+    float sigma;        /* rough diffuse */
+    int on_full;
     const float *coat_t;         /* the material's table: it outlives the bsdf */
     float opacity;   /* < 1: the rest passes straight through (Mitsuba's mask) */
     cdl_frame frame; /* shading frame; n = shading normal, front side */

@@ -17,7 +17,8 @@ typedef enum cdl_mat_type {
     CDL_MAT_ROUGH_DIELECTRIC, /* GGX microfacet glass of index eta; ks, kt */
     CDL_MAT_COATED,          /* Mitsuba's plastic: diffuse base kd under a smooth dielectric coat of
                               * index eta reflecting ks F (a Dirac lobe); see plastic.h */
-    CDL_MAT_ROUGH_COATED     /* Mitsuba's roughplastic: the same under a rough coat (mf, alpha_x) */
+    CDL_MAT_ROUGH_COATED,    /* Mitsuba's roughplastic: the same under a rough coat (mf, alpha_x) */
+    CDL_MAT_ROUGH_DIFFUSE    /* Oren-Nayar of reflectance kd, slope deviation sigma (oren_nayar.h) */
 } cdl_mat_type;
 
 /* Entries of the rough coat's transmittance table (Mitsuba's
@@ -47,6 +48,8 @@ typedef struct cdl_material {
     float coat_t[CDL_COAT_RES]; /* rough coat: transmittance from outside against cos theta */
     /* Mitsuba's mask: where opacity (times the texture's luminance) < 1 the
      * surface lets light pass straight through, as a Dirac component */
+    float sigma;       /* rough diffuse: Oren-Nayar's sigma in radians */
+    int on_full;       /* rough diffuse: the full model (Mitsuba 0.6), else the qualitative (pbrt) */
     int masked;
     float opacity;
     int opacity_tex;  /* texture index or -1 */
