@@ -548,7 +548,7 @@ static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
     if (!em)
         return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, n->line, "out of memory");
     float s = (float)scale;
-    if ((rc = cdl_envmap_load(em, path, cdl_v3(s, s, s), frame, 0, c->err))) {
+    if ((rc = cdl_envmap_load(em, path, cdl_v3(s, s, s), frame, CDL_ENVMAP_MITSUBA, c->err))) {
         free(em);
         return rc;
     }
