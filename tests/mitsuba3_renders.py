@@ -31,6 +31,7 @@ PASSING = [
     "bsdf_spheres/test_constant_path.xml",
     "bsdf_spheres/test_envmap_path.xml",
     "bsdf_spheres/test_pointlight_path.xml",
+    "bsdf_spheres/test_roughdielectric_path.xml",
     "bsdf_spheres/test_roughplastic_linear_path.xml",
     "bsdf_spheres/test_roughplastic_nonlinear_path.xml",
     "bsdf_spheres/test_textured_diffuse_path.xml",

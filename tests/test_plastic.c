@@ -29,7 +29,7 @@
 #include "scene/microfacet_mts.h"
 #include "scene/plastic.h"
 
-#define N_CHI2 40
+#define N_CHI2 48
 #include "test_stats.h"
 
 #define NSAMPLES 200000
@@ -151,17 +151,33 @@ static void test_case(const pcase *pc, double wo_deg, int tilted, uint64_t strea
           "%s: bad samples %ld, pdf vs cdl_bsdf_pdf %.1e, weight vs eval |cos| / pdf %.1e (<= 1e-3)", tag, bad,
           max_pdf_err, max_w_err);
     double alb = wsum / NSAMPLES, sd = sqrt(fmax(0.0, wsum2 / NSAMPLES - alb * alb) / NSAMPLES);
-    check(alb <= 1.0 + 5.0 * sd, "%s: albedo %.5f (<= 1 + 5 sigma)", tag, alb);
+    /* radiance leaving glass from inside gains eta^2: its albedo may pass 1 */
+    int glass = pc->type == CDL_MAT_ROUGH_DIELECTRIC;
+    if (!glass || wo_deg < 90.0)
+        check(alb <= 1.0 + 5.0 * sd, "%s: albedo %.5f (<= 1 + 5 sigma)", tag, alb);
     double and = wnd / NSAMPLES, sdn = sqrt(fmax(0.0, wnd2 / NSAMPLES - and * and) / NSAMPLES);
     check(fabs(and - ialb) <= fmax(0.01 * ialb, 5.0 * sdn) + 1e-5,
           "%s: non-Dirac albedo %.5f vs quadrature of f|cos| %.5f", tag, and, ialb);
     double max_rec = 0.0;
+    int nrec = 0, nbad = 0;
     for (int s = 0; s < 20000; s++) {
         cdl_vec3 a = random_sphere_dir(&rng), c = (s & 1) ? random_sphere_dir(&rng) : wo;
-        cdl_vec3 f1 = cdl_bsdf_eval(&b, c, a, 0), f2 = cdl_bsdf_eval(&b, a, c, 0);
-        max_rec = fmax(max_rec, fmax(rel_err(f1.x, f2.x), rel_err(f1.z, f2.z)));
+        /* glass: radiance one way is importance the other (the 1/eta^2) */
+        cdl_vec3 f1 = cdl_bsdf_eval(&b, c, a, 0), f2 = cdl_bsdf_eval(&b, a, c, glass);
+        /* where the Beckmann tail underflows (D below 1e-20 in one
+         * direction only) both are ~0: compared from 1e-5 on */
+        if (glass && fmax(fmax(f1.x, f2.x), fmax(f1.z, f2.z)) < 1e-5f)
+            continue;
+        double e = fmax(rel_err(f1.x, f2.x), rel_err(f1.z, f2.z));
+        nrec++;
+        nbad += e > 1e-3;
+        max_rec = fmax(max_rec, e);
     }
-    check(max_rec <= 1e-3, "%s: reciprocity max relative error %.1e (<= 1e-3)", tag, max_rec);
+    if (!glass)
+        check(max_rec <= 1e-3, "%s: reciprocity max relative error %.1e (<= 1e-3)", tag, max_rec);
+    else /* refraction at grazing angles loses digits in float (Walter's denominator) */
+        check(nbad <= nrec / 200, "%s: adjoint reciprocity within 1e-3 for all but %d of %d pairs (<= 0.5 %%)", tag,
+              nbad, nrec);
 }
 
 static void test_blocks(void)
@@ -214,6 +230,9 @@ int main(void)
         {"conductor ggx 0.3/0.1", CDL_MAT_CONDUCTOR, CDL_MF_GGX, 0, 0.0f, 0.3f, 0.1f, 1.0f, 1.0f},
         {"mask 0.4 over diffuse", CDL_MAT_DIFFUSE, 0, 0, 0.8f, 0.1f, 0.1f, 1.0f, 0.4f},
         {"mask 0.7 over roughplastic", CDL_MAT_ROUGH_COATED, CDL_MF_GGX, 0, 0.5f, 0.2f, 0.2f, 1.5f, 0.7f},
+        {"roughdielectric beckmann 0.3 eta=1.5", CDL_MAT_ROUGH_DIELECTRIC, CDL_MF_BECKMANN, 0, 0.0f, 0.3f, 0.3f, 1.5f,
+         1.0f},
+        {"roughdielectric ggx 0.2/0.4 eta=1.33", CDL_MAT_ROUGH_DIELECTRIC, CDL_MF_GGX, 0, 0.0f, 0.2f, 0.4f, 1.33f, 1.0f},
     };
     static const double wos[] = {0.0, 40.0, 75.0, 135.0};
     uint64_t stream = 0;

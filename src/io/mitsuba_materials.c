@@ -1,9 +1,8 @@
 /* Mitsuba bsdfs, textures and emitters as candela's materials and lights.
  * Defaults are Mitsuba 3's; what candela has no model for is approximated
- * with a warning (wavelength spectra are greys). Plastic and roughplastic
- * are Mitsuba's own coated model (scene/plastic.h); they and the rough
- * conductors use Mitsuba's microfacet model (scene/microfacet_mts.h);
- * rough dielectrics are pbrt's GGX whatever the distribution says. */
+ * with a warning. Plastic and roughplastic are Mitsuba's own coated model
+ * (scene/plastic.h); they and the rough conductors and dielectrics use
+ * Mitsuba's microfacet model (scene/microfacet_mts.h). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -398,9 +397,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             rc = roughness(c, n, rough, &m);
         m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
         m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
-        if (!rc && rough && m.mf == CDL_MF_BECKMANN)
-            cdl_mts_warn(c, n->line, "bsdf \"roughdielectric\": distribution beckmann approximated by GGX");
-        m.mf = CDL_MF_PBRT;
+        if (!rough)
+            m.mf = CDL_MF_PBRT;
     } else if (!strcmp(type, "phong")) {
         double e = 30.0;
         m = cdl_material_default(CDL_MAT_PHONG);

@@ -186,8 +186,17 @@ static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, in
         return zero; /* back-facing microfacet */
     float F = cdl_fresnel_dielectric(dio, b->eta);
     cdl_vec3 v = co > 0.0f ? lo : cdl_neg(lo); /* the viewer, on the +z side */
-    float pm = cdl_ggx_pdf_vndf(v, wm, b->ax, b->ay);
-    float D = cdl_ggx_D(wm, b->ax, b->ay), G = cdl_ggx_G(lo, li, b->ax, b->ay);
+    float pm, D, G;
+    if (b->mf != CDL_MF_PBRT) { /* Mitsuba's distributions, separable G */
+        cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+        pm = cdl_mf_pdf_vndf(&d, v, wm);
+        D = cdl_mf_D(&d, wm);
+        G = cdl_mf_G1(&d, lo, wm) * cdl_mf_G1(&d, li, wm);
+    } else {
+        pm = cdl_ggx_pdf_vndf(v, wm, b->ax, b->ay);
+        D = cdl_ggx_D(wm, b->ax, b->ay);
+        G = cdl_ggx_G(lo, li, b->ax, b->ay);
+    }
     if (reflect) {
         *pdf = pm / (4.0f * fabsf(dio)) * F;
         return cdl_scale(b->ks, D * G * F / fabsf(4.0f * ci * co));
@@ -306,8 +315,13 @@ static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     cdl_vec3 lo = cdl_to_local(&b->frame, wo);
     if (lo.z == 0.0f)
         return 0;
-    cdl_vec3 v = lo.z > 0.0f ? lo : cdl_neg(lo);
-    cdl_vec3 wm = cdl_ggx_sample_vndf(v, b->ax, b->ay, u1, u2);
+    cdl_vec3 v = lo.z > 0.0f ? lo : cdl_neg(lo), wm;
+    if (b->mf != CDL_MF_PBRT) {
+        cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+        wm = cdl_mf_sample_vndf(&d, v, u1, u2);
+    } else {
+        wm = cdl_ggx_sample_vndf(v, b->ax, b->ay, u1, u2);
+    }
     float dio = cdl_dot(lo, wm);
     float F = cdl_fresnel_dielectric(dio, b->eta);
     cdl_vec3 li;
