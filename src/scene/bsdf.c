@@ -24,6 +24,8 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     if (cdl_dot(ns, ng) < 0.0f)
         ns = cdl_neg(ns);
     b->frame = cdl_frame_from(ns);
+    b->nb = ns;
+    b->perturbed = 0;
     b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PHONG) {
         /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
@@ -175,7 +177,7 @@ static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, in
     return cdl_scale(b->kt, ft);
 }
 
-cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
+static cdl_vec3 eval_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
     cdl_vec3 lo, li;
     float pdf;
@@ -191,7 +193,7 @@ cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
     return opaque_eval(b, lo, li, &pdf);
 }
 
-float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+static float pdf_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
     float pdf = 0.0f;
@@ -296,8 +298,8 @@ static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     return 1;
 }
 
-int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
-                    int adjoint, cdl_scatter *s)
+static int sample_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint,
+                              cdl_scatter *s)
 {
     if (b->type == CDL_MAT_MIRROR) {
         cdl_vec3 n = b->frame.n;
@@ -341,4 +343,49 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC)
         return sample_rough_glass(b, wo, u0, u1, u2, adjoint, s);
     return sample_opaque(b, wo, u0, u1, u2, s);
+}
+
+/* A frame perturbed by a bump or normal map (Mitsuba's bumpmap and
+ * normalmap): wi must lie on the same side of the unperturbed and the
+ * perturbed normal, and the response is shadowed by Conty Estevez et al.'s
+ * microfacet term (Ray Tracing Gems, 2019, ch. 12) with alpha^2 =
+ * tan^2(perturbation) / 8, as Mitsuba's use_shadowing_function. Returns
+ * the factor on f (0: blocked). */
+static float perturbation_factor(const cdl_bsdf *b, cdl_vec3 wi)
+{
+    float cb = cdl_dot(wi, b->nb), cp = cdl_dot(wi, b->frame.n);
+    if (!(cb * cp > 0.0f))
+        return 0.0f;
+    float cn = cdl_dot(b->frame.n, b->nb);
+    float tn = cn != 0.0f ? (1.0f - cn * cn) / (cn * cn) : INFINITY;
+    float a2 = cdl_minf(0.125f * tn, 1.0f);
+    float tw = (1.0f - cb * cb) / (cb * cb);
+    float g = 2.0f / (1.0f + sqrtf(1.0f + a2 * tw));
+    return isfinite(g) ? g : 0.0f;
+}
+
+cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
+{
+    if (!b->perturbed)
+        return eval_unperturbed(b, wo, wi, adjoint);
+    float k = perturbation_factor(b, wi);
+    return k > 0.0f ? cdl_scale(eval_unperturbed(b, wo, wi, adjoint), k) : cdl_v3(0.0f, 0.0f, 0.0f);
+}
+
+float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+{
+    if (b->perturbed && !(perturbation_factor(b, wi) > 0.0f))
+        return 0.0f;
+    return pdf_unperturbed(b, wo, wi);
+}
+
+int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint, cdl_scatter *s)
+{
+    if (!sample_unperturbed(b, wo, u0, u1, u2, adjoint, s))
+        return 0;
+    if (!b->perturbed)
+        return 1;
+    float k = perturbation_factor(b, s->wi);
+    s->weight = cdl_scale(s->weight, k);
+    return k > 0.0f;
 }

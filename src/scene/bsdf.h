@@ -18,6 +18,8 @@ typedef struct cdl_bsdf {
     int fresnel;     /* mirror: ks times the conductor Fresnel term of eta3, k3 */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
+    cdl_vec3 nb;     /* shading normal before a bump/normal map (frame.n without) */
+    int perturbed;   /* frame.n differs from nb: Mitsuba's checks and shadowing term apply */
 } cdl_bsdf;
 
 typedef struct cdl_scatter {
