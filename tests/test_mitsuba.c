@@ -503,6 +503,62 @@ static void shared_scenes(const char *root)
     cdl_scene_free(&s);
 }
 
+
+/* Mitsuba textures (issue 27): a checkerboard alpha_u with to_uv, a-C, a
+ * bitmap's wrap, filter and to_uv, bumpmap and normalmap over a nested
+ * bsdf, and the rectangle's uv in candela's convention. */
+static void textures_and_maps(void)
+{
+    write_file("maps.xml",
+               "<scene version=\"3.0.0\">\n" LIGHT
+               "<shape type=\"rectangle\"><bsdf type=\"roughconductor\"><string name=\"material\" value=\"a-C\"/>"
+               "<texture name=\"alpha_u\" type=\"checkerboard\"><transform name=\"to_uv\"><scale x=\"25\" y=\"25\"/>"
+               "</transform><float name=\"color0\" value=\"0.05\"/><float name=\"color1\" value=\"0.3\"/></texture>"
+               "<float name=\"alpha_v\" value=\"0.2\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"bumpmap\"><float name=\"scale\" value=\"0.02\"/>"
+               "<texture name=\"h\" type=\"bitmap\"><boolean name=\"raw\" value=\"true\"/>"
+               "<string name=\"filename\" value=\"px.png\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"normalmap\"><texture name=\"normalmap\" type=\"rawconstant\">"
+               "<vector name=\"value\" value=\"0.5, 0.5, 1.0\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>\n"
+               "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\">"
+               "<transform name=\"to_uv\"><scale value=\"2\"/><translate value=\"-.5,-.5, 0\"/></transform>"
+               "<string name=\"filename\" value=\"px.png\"/><string name=\"wrap_mode\" value=\"mirror\"/>"
+               "<string name=\"filter_type\" value=\"nearest\"/></texture></bsdf></shape>\n"
+               "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("maps.xml", &s, &set)) {
+        CHECK(0, "maps.xml loads");
+        return;
+    }
+    const cdl_material *cond = &s.mats[s.tri_mat[0]], *bump = &s.mats[s.tri_mat[2]], *nm = &s.mats[s.tri_mat[4]],
+                       *bm = &s.mats[s.tri_mat[6]];
+    int at = cond->maps.alpha_tex[0];
+    CHECK(at >= 0 && s.texs[at].type == CDL_TEX_CHECKER && cond->maps.alpha_tex[1] < 0 &&
+              fabsf(cond->alpha_y - 0.2f) < 1e-6f && fabsf(s.texs[at].m[0] - 25.0f) < 1e-5f,
+          "alpha_u is a checkerboard with to_uv scale 25, alpha_v the float 0.2");
+    CHECK(near3(cond->eta3, cdl_v3(2.943f, 2.228f, 1.965f), 2e-3f) && near3(cond->k3, cdl_v3(0.887f, 0.799f, 0.814f), 2e-3f),
+          "a-C: eta (%.3f %.3f %.3f), k (%.3f %.3f %.3f)", (double)cond->eta3.x, (double)cond->eta3.y,
+          (double)cond->eta3.z, (double)cond->k3.x, (double)cond->k3.y, (double)cond->k3.z);
+    int bt = bump->maps.bump_tex;
+    CHECK(bump->type == CDL_MAT_DIFFUSE && bt >= 0 && s.texs[bt].type == CDL_TEX_BITMAP &&
+              fabsf(s.texs[bt].rgb[0] - 0.537f) < 0.003f && fabsf(bump->maps.bump_scale - 0.02f) < 1e-7f,
+          "bumpmap: diffuse with a raw bitmap (texel %g: the file's sRGB 0.537 of 0.25, undecoded) and scale 0.02",
+          bt >= 0 ? (double)s.texs[bt].rgb[0] : -1.0);
+    int nt = nm->maps.normal_tex;
+    CHECK(nt >= 0 && s.texs[nt].type == CDL_TEX_CONST && near3(s.texs[nt].a, cdl_v3(0.5f, 0.5f, 1.0f), 0.0f),
+          "normalmap: the rawconstant (0.5, 0.5, 1)");
+    int kt = bm->kd_tex;
+    CHECK(kt >= 0 && s.texs[kt].wrap == CDL_WRAP_MIRROR && s.texs[kt].nearest && fabsf(s.texs[kt].m[0] - 2.0f) < 1e-6f &&
+              fabsf(s.texs[kt].m[2] + 0.5f) < 1e-6f && fabsf(s.texs[kt].m[4] + 2.0f) < 1e-6f &&
+              fabsf(s.texs[kt].m[5] - 1.5f) < 1e-6f,
+          "bitmap: mirror, nearest, to_uv (2 u - 0.5, 2 (1 - v) - 0.5)");
+    const float *uv0 = s.uv + 2 * (size_t)s.idx[0];
+    CHECK(uv0[0] == 0.0f && uv0[1] == 1.0f, "rectangle corner (-1, -1): candela uv (%g, %g), Mitsuba's (0, 0) flipped",
+          (double)uv0[0], (double)uv0[1]);
+    cdl_scene_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     snprintf(dir, sizeof dir, "/tmp/candela-mitsuba.XXXXXX");
@@ -518,6 +574,7 @@ int main(int argc, char **argv)
     spectra();
     cylinder();
     nested_ids();
+    textures_and_maps();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

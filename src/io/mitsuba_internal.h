@@ -122,4 +122,15 @@ int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n);
 /* Mitsuba's default surface, diffuse 0.5, made on first use. */
 int cdl_mts_default_material(cdl_mts_ctx *c, int32_t *mat);
 
+/* mitsuba_textures.c */
+/* A texture plugin other than the constant ones of cdl_mts_texture
+ * (bitmap, checkerboard, scale, rawconstant): the scene texture. */
+int cdl_mts_texture_plugin(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, int *tex, cdl_vec3 *value);
+/* A float property that may be a texture (*tex >= 0; its scalar value). */
+int cdl_mts_float_or_texture(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, double def, double *out, int *tex);
+/* bumpmap / normalmap: a copy of the nested bsdf's material with the map. */
+int cdl_mts_perturbed_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, int32_t *mat);
+/* eta and k of a named conductor ("Al", "a-C"...) in RGB; -1 if unknown. */
+int cdl_mts_named_conductor(const char *name, cdl_vec3 *eta, cdl_vec3 *k);
+
 #endif

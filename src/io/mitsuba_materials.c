@@ -149,10 +149,15 @@ static int roughness(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
     double a, au, av;
     char dist[32];
     int rc;
-    if ((rc = cdl_mts_float(c, n, "alpha", rough ? 0.1 : 0.0, &a)) ||
-        (rc = cdl_mts_float(c, n, "alpha_u", a, &au)) || (rc = cdl_mts_float(c, n, "alpha_v", a, &av)) ||
+    int ta, tu, tv;
+    if ((rc = cdl_mts_float_or_texture(c, n, "alpha", rough ? 0.1 : 0.0, &a, &ta)) ||
+        (rc = cdl_mts_float_or_texture(c, n, "alpha_u", a, &au, &tu)) ||
+        (rc = cdl_mts_float_or_texture(c, n, "alpha_v", a, &av, &tv)) ||
         (rc = cdl_mts_string(c, n, "distribution", "beckmann", dist, sizeof dist)))
         return rc;
+    m->maps.alpha_tex[0] = tu >= 0 ? tu : (cdl_mts_prop(c, n, "alpha_u") ? -1 : ta);
+    m->maps.alpha_tex[1] = tv >= 0 ? tv : (cdl_mts_prop(c, n, "alpha_v") ? -1 : ta);
+    m->maps.on = 1;
     if (!(au >= 0.0 && av >= 0.0 && au <= 10.0 && av <= 10.0))
         return cdl_mts_error(c, n->line, "alpha (%g, %g) must be in [0, 10]", au, av);
     if (rough && strcmp(dist, "ggx") && strcmp(dist, "beckmann") && strcmp(dist, "phong"))
@@ -237,11 +242,7 @@ static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
         m->eta3 = cdl_v3(0, 0, 0);
         m->k3 = cdl_v3(1, 1, 1);
     } else {
-        char ne[48], nk[48];
-        snprintf(ne, sizeof ne, "metal-%s-eta", metal);
-        snprintf(nk, sizeof nk, "metal-%s-k", metal);
-        int r1 = cdl_pbrt_named_spectrum(ne, &m->eta3), r2 = cdl_pbrt_named_spectrum(nk, &m->k3);
-        if (r1 < 0 || r2 < 0 || r1 == 1) {
+        if (cdl_mts_named_conductor(metal, &m->eta3, &m->k3)) {
             cdl_mts_warn(c, n->line, "conductor material \"%s\" is not in candela's table: copper is used", metal);
             cdl_pbrt_named_spectrum("metal-Cu-eta", &m->eta3);
             cdl_pbrt_named_spectrum("metal-Cu-k", &m->k3);
@@ -348,6 +349,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         return mask(c, n, mat);
     static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "blendbsdf", "coating",
                                        "roughcoating"};
+    if (!strcmp(type, "bumpmap") || !strcmp(type, "normalmap"))
+        return cdl_mts_perturbed_bsdf(c, n, type, mat);
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
         if (!strcmp(type, wrap[i])) {
             if ((rc = cdl_mts_child_bsdf(c, n, 0, mat, &found)))
@@ -458,32 +461,10 @@ int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value)
     n->used = 1;
     *tex = -1;
     *value = cdl_v3(1, 1, 1);
-    if (!strcmp(type, "bitmap")) {
-        char fn[1024], path[1024];
-        if ((rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn)))
+    if (!strcmp(type, "bitmap") || !strcmp(type, "checkerboard") || !strcmp(type, "scale") ||
+        !strcmp(type, "rawconstant")) {
+        if ((rc = cdl_mts_texture_plugin(c, n, type, tex, value)))
             return rc;
-        if (!fn[0])
-            return cdl_mts_error(c, n->line, "texture \"bitmap\" needs a \"filename\"");
-        if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)) ||
-            (rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_texture(c->s, path, tex, c->err))))
-            return rc;
-        /* sampling details: candela filters bilinearly and repeats */
-        static const char *const fine[] = {"filter_type", "wrap_mode", "raw", "gamma", "cache", "max_anisotropy",
-                                           "format", "channel"};
-        for (size_t i = 0; i < sizeof fine / sizeof fine[0]; i++)
-            cdl_mts_prop(c, n, fine[i]);
-        static const char *const uvs[] = {"to_uv", "uscale", "vscale", "uoffset", "voffset"};
-        for (size_t i = 0; i < sizeof uvs / sizeof uvs[0]; i++)
-            if (cdl_mts_prop(c, n, uvs[i]))
-                cdl_mts_warn(c, n->line, "texture \"bitmap\": %s ignored (uv used as given)", uvs[i]);
-    } else if (!strcmp(type, "checkerboard")) {
-        cdl_vec3 a, b;
-        if ((rc = color(c, n, "color0", cdl_v3(0.4f, 0.4f, 0.4f), &a, NULL)) ||
-            (rc = color(c, n, "color1", cdl_v3(0.2f, 0.2f, 0.2f), &b, NULL)))
-            return rc;
-        cdl_mts_warn(c, n->line, "texture \"checkerboard\": rendered as the mean of its colors");
-        *value = cdl_scale(cdl_add(a, b), 0.5f);
-        cdl_mts_prop(c, n, "to_uv");
     } else {
         cdl_mts_warn(c, n->line, "texture \"%s\" is not supported: a constant 0.5", type);
         *value = cdl_v3(0.5f, 0.5f, 0.5f);

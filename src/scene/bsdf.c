@@ -35,6 +35,8 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     if (cdl_dot(ns, ng) < 0.0f)
         ns = cdl_neg(ns);
     b->frame = cdl_frame_from(ns);
+    b->nb = ns;
+    b->perturbed = 0;
     b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PHONG) {
         /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
@@ -210,7 +212,7 @@ static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, in
     return cdl_scale(b->kt, ft);
 }
 
-static cdl_vec3 eval_opaque_or_glass(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
+static cdl_vec3 eval_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
     cdl_vec3 lo, li;
     float pdf;
@@ -226,7 +228,7 @@ static cdl_vec3 eval_opaque_or_glass(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi
     return opaque_eval(b, lo, li, &pdf);
 }
 
-static float pdf_opaque_or_glass(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+static float pdf_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
     float pdf = 0.0f;
@@ -357,8 +359,8 @@ static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     return 1;
 }
 
-static int sample_any(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
-                      int adjoint, cdl_scatter *s)
+static int sample_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint,
+                              cdl_scatter *s)
 {
     if (b->type == CDL_MAT_MIRROR) {
         cdl_vec3 n = b->frame.n;
@@ -404,32 +406,59 @@ static int sample_any(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float 
     return sample_opaque(b, wo, u0, u1, u2, s);
 }
 
+/* A frame perturbed by a bump or normal map (Mitsuba's bumpmap and
+ * normalmap): wi must lie on the same side of the unperturbed and the
+ * perturbed normal, and the response is shadowed by Conty Estevez et al.'s
+ * microfacet term (Ray Tracing Gems, 2019, ch. 12) with alpha^2 =
+ * tan^2(perturbation) / 8, as Mitsuba's use_shadowing_function. Returns
+ * the factor on f (0: blocked). */
+static float perturbation_factor(const cdl_bsdf *b, cdl_vec3 wi)
+{
+    float cb = cdl_dot(wi, b->nb), cp = cdl_dot(wi, b->frame.n);
+    if (!(cb * cp > 0.0f))
+        return 0.0f;
+    float cn = cdl_dot(b->frame.n, b->nb);
+    float tn = cn != 0.0f ? (1.0f - cn * cn) / (cn * cn) : INFINITY;
+    float a2 = cdl_minf(0.125f * tn, 1.0f);
+    float tw = (1.0f - cb * cb) / (cb * cb);
+    float g = 2.0f / (1.0f + sqrtf(1.0f + a2 * tw));
+    return isfinite(g) ? g : 0.0f;
+}
+
 /* Mitsuba's mask: the material scatters with probability opacity and
  * lets the rest pass straight on (a Dirac component, weight 1). */
 cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
-    return cdl_scale(eval_opaque_or_glass(b, wo, wi, adjoint), b->opacity);
-}
+    cdl_vec3 f = cdl_scale(eval_unperturbed(b, wo, wi, adjoint), b->opacity);
+    if (!b->perturbed)
+        return f;
+    float k = perturbation_factor(b, wi);
+    return k > 0.0f ? cdl_scale(f, k) : cdl_v3(0.0f, 0.0f, 0.0f);}
 
 float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
-    return pdf_opaque_or_glass(b, wo, wi) * b->opacity;
+    if (b->perturbed && !(perturbation_factor(b, wi) > 0.0f))
+        return 0.0f;
+    return pdf_unperturbed(b, wo, wi) * b->opacity;
 }
 
-int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
-                    int adjoint, cdl_scatter *s)
+int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint, cdl_scatter *s)
 {
-    if (b->opacity >= 1.0f)
-        return sample_any(b, wo, u0, u1, u2, adjoint, s);
-    if (u0 >= b->opacity) {
-        s->wi = cdl_neg(wo);
-        s->weight = cdl_v3(1.0f, 1.0f, 1.0f);
-        s->pdf = 1.0f - b->opacity;
-        s->delta = 1;
-        return 1;
+    if (b->opacity < 1.0f) {
+        if (u0 >= b->opacity) { /* through the mask */
+            s->wi = cdl_neg(wo);
+            s->weight = cdl_v3(1.0f, 1.0f, 1.0f);
+            s->pdf = 1.0f - b->opacity;
+            s->delta = 1;
+            return 1;
+        }
+        u0 /= b->opacity;
     }
-    if (!sample_any(b, wo, u0 / b->opacity, u1, u2, adjoint, s))
+    if (!sample_unperturbed(b, wo, u0, u1, u2, adjoint, s))
         return 0;
     s->pdf *= b->opacity; /* the weight keeps opacity f / (opacity pdf) */
-    return 1;
-}
+    if (!b->perturbed)
+        return 1;
+    float k = perturbation_factor(b, s->wi);
+    s->weight = cdl_scale(s->weight, k);
+    return k > 0.0f;}

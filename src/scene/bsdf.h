@@ -24,6 +24,8 @@ typedef struct cdl_bsdf {
     float opacity;   /* < 1: the rest passes straight through (Mitsuba's mask) */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
+    cdl_vec3 nb;     /* shading normal before a bump/normal map (frame.n without) */
+    int perturbed;   /* frame.n differs from nb: Mitsuba's checks and shadowing term apply */
 } cdl_bsdf;
 
 typedef struct cdl_scatter {

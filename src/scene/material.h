@@ -29,6 +29,27 @@ typedef enum cdl_mat_type {
  * to, never stores photons. */
 static inline int cdl_mat_is_delta(cdl_mat_type t) { return t == CDL_MAT_MIRROR || t == CDL_MAT_DIELECTRIC; }
 
+/* Textures that vary a material over its surface beyond kd (texture
+ * indices, -1 = none). bump: Mitsuba's bumpmap (the height's uv gradient
+ * times bump_scale tilts the shading frame); normal: Mitsuba's normalmap
+ * (2 rgb - 1 is the normal in the unperturbed shading frame). Read only
+ * when `on`, so that a zeroed material has none. */
+typedef struct cdl_mat_maps {
+    int on;
+    int alpha_tex[2]; /* alpha_x, alpha_y from the textures' scalar values */
+    int bump_tex;
+    float bump_scale;
+    int normal_tex;
+} cdl_mat_maps;
+
+/* The shading frame of this material follows dp/du (Mitsuba's): its
+ * roughness is anisotropic or a map perturbs the frame. */
+static inline int cdl_mat_uses_tangent(const cdl_mat_maps *mm, float ax, float ay)
+{
+    return ax != ay ||
+           (mm->on && (mm->alpha_tex[0] >= 0 || mm->alpha_tex[1] >= 0 || mm->bump_tex >= 0 || mm->normal_tex >= 0));
+}
+
 typedef struct cdl_material {
     cdl_mat_type type;
     cdl_vec3 kd;      /* diffuse reflectance, multiplied by the texture */
@@ -53,6 +74,7 @@ typedef struct cdl_material {
     int masked;
     float opacity;
     int opacity_tex;  /* texture index or -1 */
+    cdl_mat_maps maps; /* textured roughness, bump and normal maps */
     char name[64];
 } cdl_material;
 
@@ -77,7 +99,8 @@ static inline float cdl_phong_energy_scale(const cdl_material *m)
  * becomes a mirror with the conductor's Fresnel term. */
 static inline cdl_material cdl_material_canonical(cdl_material m)
 {
-    if (m.type == CDL_MAT_CONDUCTOR && m.alpha_x < CDL_SMOOTH_ALPHA && m.alpha_y < CDL_SMOOTH_ALPHA) {
+    if (m.type == CDL_MAT_CONDUCTOR && m.alpha_x < CDL_SMOOTH_ALPHA && m.alpha_y < CDL_SMOOTH_ALPHA &&
+        !(m.maps.on && (m.maps.alpha_tex[0] >= 0 || m.maps.alpha_tex[1] >= 0))) {
         m.type = CDL_MAT_MIRROR;
         m.fresnel = 1;
     }
@@ -97,6 +120,8 @@ static inline cdl_material cdl_material_default(cdl_mat_type type)
     m.eta3 = cdl_v3(0.2f, 0.92f, 1.1f); /* copper-like, pbrt's default metal */
     m.k3 = cdl_v3(3.91f, 2.45f, 2.14f);
     m.alpha_x = m.alpha_y = 0.1f;
+    m.maps.alpha_tex[0] = m.maps.alpha_tex[1] = m.maps.bump_tex = m.maps.normal_tex = -1;
+    m.maps.bump_scale = 1.0f;
     return m;
 }
 

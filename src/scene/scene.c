@@ -7,6 +7,7 @@
 
 #include "core/grow.h"
 #include "core/log.h"
+#include "scene/shading.h"
 
 
 static void embree_error(void *user, enum RTCError code, const char *str)
@@ -135,6 +136,11 @@ int cdl_scene_add_triangle(cdl_scene *s, uint32_t a, uint32_t b, uint32_t c,
 
 int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err)
 {
+    const cdl_mat_maps *mm = &m->maps;
+    int refs[4] = {mm->alpha_tex[0], mm->alpha_tex[1], mm->bump_tex, mm->normal_tex};
+    for (int k = 0; k < 4 && mm->on; k++)
+        if (refs[k] < -1 || refs[k] >= (int)s->ntexs)
+            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "material texture %d out of range", refs[k]);
     if (cdl_grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for materials");
     s->mats[s->nmats] = cdl_material_canonical(*m);
@@ -149,6 +155,22 @@ int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *er
     int rc = cdl_texture_load(&s->texs[s->ntexs], path, err);
     if (rc)
         return rc;
+    *id = (int)s->ntexs++;
+    return 0;
+}
+
+int cdl_scene_add_texture_data(cdl_scene *s, cdl_texture *t, int *id, cdl_error *err)
+{
+    for (int k = 0; k < 2; k++)
+        if (t->sub[k] >= (int)s->ntexs || t->sub[k] < -1) {
+            cdl_texture_free(t);
+            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sub-texture %d out of range", t->sub[k]);
+        }
+    if (cdl_grow((void **)&s->texs, &s->cap_texs, s->ntexs + 1, sizeof(cdl_texture))) {
+        cdl_texture_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for textures");
+    }
+    s->texs[s->ntexs] = *t;
     *id = (int)s->ntexs++;
     return 0;
 }
@@ -470,6 +492,22 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
     }
 }
 
+/* dp/du and dp/dv of a triangle from its uv (Mitsuba's and pbrt's
+ * solution of the 2x2 system); zero where the uv are degenerate. */
+static void tri_partials(const float *p0, const float *p1, const float *p2, const float *u0, const float *u1,
+                         const float *u2, cdl_surface *sf)
+{
+    float du0 = u1[0] - u0[0], dv0 = u1[1] - u0[1], du1 = u2[0] - u0[0], dv1 = u2[1] - u0[1];
+    cdl_vec3 e0 = cdl_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]);
+    cdl_vec3 e1 = cdl_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]);
+    float det = du0 * dv1 - dv0 * du1;
+    if (det == 0.0f || !isfinite(1.0f / det))
+        return;
+    float inv = 1.0f / det;
+    sf->dpdu = cdl_scale(cdl_sub(cdl_scale(e0, dv1), cdl_scale(e1, dv0)), inv);
+    sf->dpdv = cdl_scale(cdl_sub(cdl_scale(e1, du0), cdl_scale(e0, du1)), inv);
+}
+
 static void sphere_surface(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
     const float *q = s->sph + 4 * (size_t)h->prim;
@@ -483,6 +521,11 @@ static void sphere_surface(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf
     sf->ng = sf->ns = n;
     sf->u = 0.5f + atan2f(out.z, out.x) * (0.5f * CDL_INV_PI);
     sf->v = acosf(cdl_maxf(-1.0f, cdl_minf(1.0f, out.y))) * CDL_INV_PI;
+    /* p = c + r (sin th cos ph, cos th, sin th sin ph), ph = 2 pi (u - 1/2), th = pi v */
+    float st = sqrtf(cdl_maxf(0.0f, 1.0f - out.y * out.y)), r = q[3];
+    float cp = st > 0.0f ? out.x / st : 1.0f, sp = st > 0.0f ? out.z / st : 0.0f;
+    sf->dpdu = cdl_scale(cdl_v3(-st * sp, 0.0f, st * cp), 2.0f * CDL_PI * r);
+    sf->dpdv = cdl_scale(cdl_v3(out.y * cp, -st, out.y * sp), CDL_PI * r);
     sf->prim = h->prim;
     sf->geom = CDL_GEOM_SPHERES;
     sf->mat = s->sph_mat[h->prim];
@@ -493,6 +536,7 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
     if (h->geom == CDL_GEOM_SPHERES) {
         sphere_surface(s, h, sf);
+        cdl_surface_shade(s, sf, cdl_neg(h->d));
         return;
     }
     const uint32_t *t = s->idx + 3 * (size_t)h->prim;
@@ -517,16 +561,19 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
             sf->ns = cdl_scale(n, 1.0f / len);
     }
     sf->u = sf->v = 0.0f;
+    sf->dpdu = sf->dpdv = cdl_v3(0.0f, 0.0f, 0.0f);
     if (fl & CDL_TRI_HAS_UV) {
         const float *u0 = s->uv + 2 * (size_t)t[0], *u1 = s->uv + 2 * (size_t)t[1],
                     *u2 = s->uv + 2 * (size_t)t[2];
         sf->u = b0 * u0[0] + h->b1 * u1[0] + h->b2 * u2[0];
         sf->v = b0 * u0[1] + h->b1 * u1[1] + h->b2 * u2[1];
+        tri_partials(p0, p1, p2, u0, u1, u2, sf);
     }
     sf->prim = h->prim;
     sf->geom = CDL_GEOM_TRIANGLES;
     sf->mat = s->tri_mat[h->prim];
     sf->light = s->tri_light[h->prim];
+    cdl_surface_shade(s, sf, cdl_neg(h->d));
 }
 
 void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
@@ -534,9 +581,9 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
     const cdl_material *m = &s->mats[sf->mat];
     cdl_vec3 kd = m->kd;
     if (m->kd_tex >= 0)
-        kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
+        kd = cdl_mul(kd, cdl_texture_eval(s->texs, m->kd_tex, sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
     if (m->masked && m->opacity_tex >= 0)
-        b->opacity *= cdl_minf(1.0f, cdl_maxf(0.0f, cdl_luminance(cdl_texture_lookup(&s->texs[m->opacity_tex],
-                                                                                      sf->u, sf->v))));
+        b->opacity *= cdl_minf(1.0f, cdl_maxf(0.0f, cdl_texture_eval1(s->texs, m->opacity_tex, sf->u, sf->v)));
+    cdl_scene_bsdf_maps(s, m, sf, b);
 }

@@ -115,6 +115,9 @@ int cdl_scene_add_sphere(cdl_scene *s, cdl_vec3 c, float radius, uint32_t mat, i
                          int inward, cdl_error *err);
 int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cdl_error *err);
 int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *err);
+/* A texture made by the caller, taken over (freed on error too); its
+ * sub-texture indices must name textures added before. */
+int cdl_scene_add_texture_data(cdl_scene *s, cdl_texture *t, int *id, cdl_error *err);
 /* I is the intensity in W/sr. */
 int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err);
 /* Spot at p pointing along dir; cone angles in degrees (pbrt's coneangle, conedelta). */
@@ -138,10 +141,14 @@ typedef struct cdl_hit {
     uint32_t prim;   /* triangle or sphere index */
     uint32_t geom;   /* CDL_GEOM_* */
     cdl_vec3 ng;     /* Embree's unnormalized geometric normal */
+    cdl_vec3 d;      /* the ray's direction (a view-dependent shading frame reads it) */
 } cdl_hit;
 
 typedef struct cdl_surface {
-    cdl_vec3 p, ng, ns; /* ng: unit CCW normal */
+    cdl_vec3 p, ng, ns; /* ng: unit CCW normal; ns: shading normal (after bump/normal maps) */
+    cdl_vec3 ts;        /* shading tangent along dp/du (perpendicular to ns), or zero: any */
+    cdl_vec3 nb;        /* shading normal before bump/normal maps (== ns without) */
+    cdl_vec3 dpdu, dpdv; /* partials of p over (u, v), zero without uv */
     float u, v;
     uint32_t prim, geom, mat;
     int32_t light;      /* index of the area light on this shape, or -1 */
@@ -182,6 +189,7 @@ static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, floa
     h->prim = rh.hit.primID;
     h->geom = rh.hit.geomID;
     h->ng = cdl_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    h->d = d;
     return 1;
 }
 
@@ -229,8 +237,13 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
                          const cdl_vec3 *d, const float *tmax, uint32_t skip_sphere,
                          uint8_t *blocked);
 
+/* The surface at a hit, its shading frame perturbed by the material's bump
+ * or normal map (seen along h->d) as every method sees it. */
 void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
-/* Texture lookup folded in. */
+/* The tangent frame and bump/normal map of sf's material applied to sf
+ * (sf->ns, nb and ts), for a viewer in direction wo (scene/shading.c). */
+void cdl_surface_shade(const cdl_scene *s, cdl_surface *sf, cdl_vec3 wo);
+/* Texture lookup folded in; the frame is sf's ns and ts. */
 void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
 
 /* Origin for a ray leaving p in direction d: pushed off the surface along

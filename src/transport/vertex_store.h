@@ -25,6 +25,7 @@ enum {
 typedef struct cdl_vertex_store {
     uint32_t n, cap;
     cdl_vec3 *p, *ns, *ng; /* position, shading and geometric normal */
+    cdl_vec3 *ts, *nb;     /* shading tangent and unperturbed normal (cdl_surface's; zero: none) */
     cdl_vec3 *wi;          /* unit direction towards the previous vertex */
     cdl_vec3 *beta;        /* throughput up to and including this vertex */
     float *pdf_fwd;        /* area density of this vertex from its predecessor */

@@ -1,0 +1,207 @@
+/* Textures and shading frames as Mitsuba 3 defines them (issue 27):
+ * bitmap lookups at known texels with each wrap and filter mode, the
+ * checkerboard's two conventions, the bilinear gradient, a bump map of a
+ * linear height field tilting the normal by the analytic angle, and an
+ * identity normal map leaving the BSDF unchanged. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "scene/shading.h"
+#include "test_util.h"
+
+static int near3(cdl_vec3 a, cdl_vec3 b, float tol)
+{
+    return fabsf(a.x - b.x) <= tol && fabsf(a.y - b.y) <= tol && fabsf(a.z - b.z) <= tol;
+}
+
+/* A w x h grey image whose texel (x, y) holds f(x, y). */
+static cdl_texture grey(int w, int h, float (*f)(int, int))
+{
+    cdl_texture t;
+    cdl_texture_init(&t, CDL_TEX_BITMAP);
+    t.w = w;
+    t.h = h;
+    t.rgb = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int k = 0; k < 3; k++)
+                t.rgb[3 * (y * w + x) + k] = f(x, y);
+    return t;
+}
+
+static float index_value(int x, int y) { return (float)(x + 10 * y); }
+static float ramp(int x, int y)
+{
+    (void)y;
+    return 0.1f * (float)x;
+}
+
+/* Image coordinates (s, t) of the texture are (u, 1 - v) by default:
+ * surface (u, v) for a given s, t. */
+static float val(const cdl_texture *t, float s, float tt) { return cdl_texture_eval(t, 0, s, 1.0f - tt).x; }
+
+static void lookups(void)
+{
+    cdl_texture t = grey(4, 2, index_value);
+    /* texel centres at (i + 0.5) / w; t = 0 is the top row */
+    CHECK(fabsf(val(&t, 0.625f, 0.25f) - 2.0f) < 1e-5f, "bilinear at texel (2, 0)'s centre: %g (2)",
+          (double)val(&t, 0.625f, 0.25f));
+    CHECK(fabsf(val(&t, 0.5f, 0.75f) - 11.5f) < 1e-5f, "bilinear between (1, 1) and (2, 1): %g (11.5)",
+          (double)val(&t, 0.5f, 0.75f));
+    /* at s = 0 the lookup straddles texel -1 and texel 0 */
+    float rep = val(&t, 0.0f, 0.25f);
+    t.wrap = CDL_WRAP_MIRROR;
+    float mir = val(&t, 0.0f, 0.25f);
+    t.wrap = CDL_WRAP_CLAMP;
+    float cla = val(&t, 0.0f, 0.25f);
+    CHECK(fabsf(rep - 1.5f) < 1e-5f && fabsf(mir) < 1e-5f && fabsf(cla) < 1e-5f,
+          "left edge: repeat %g (1.5, texels 3 and 0), mirror %g (0), clamp %g (0)", (double)rep, (double)mir,
+          (double)cla);
+    /* nearest, one texel past the right edge and two widths to the left */
+    t.nearest = 1;
+    float r[3], l[3];
+    for (int m = 0; m < 3; m++) {
+        t.wrap = m;
+        r[m] = val(&t, 1.0f + 0.125f, 0.25f);
+        l[m] = val(&t, -2.0f + 0.375f, 0.25f); /* texel -7 */
+    }
+    CHECK(r[CDL_WRAP_REPEAT] == 0.0f && r[CDL_WRAP_MIRROR] == 3.0f && r[CDL_WRAP_CLAMP] == 3.0f,
+          "texel 4: repeat %g (0), mirror %g (3), clamp %g (3)", (double)r[0], (double)r[1], (double)r[2]);
+    CHECK(l[CDL_WRAP_REPEAT] == 1.0f && l[CDL_WRAP_MIRROR] == 1.0f && l[CDL_WRAP_CLAMP] == 0.0f,
+          "texel -7: repeat %g (1), mirror %g (1: 0 1 2 3 3 2 1 0 ...), clamp %g (0)", (double)l[0],
+          (double)l[1], (double)l[2]);
+    /* a to_uv of scale 2, translate -0.5 (texture_interp's) */
+    t.nearest = 0;
+    t.wrap = CDL_WRAP_REPEAT;
+    t.m[0] = 2.0f, t.m[1] = 0.0f, t.m[2] = -0.5f;
+    float v0 = cdl_texture_eval(&t, 0, 0.3125f, 0.5f).x; /* s = 0.125 */
+    CHECK(fabsf(v0 - 5.0f) < 1e-5f, "uv map: s = 0.125, t = 0.5 gives %g (5)", (double)v0);
+    cdl_texture_free(&t);
+}
+
+static void checker(void)
+{
+    cdl_texture t;
+    cdl_texture_init(&t, CDL_TEX_CHECKER);
+    t.a = cdl_v3(0.05f, 0.05f, 0.05f);
+    t.b = cdl_v3(0.3f, 0.3f, 0.3f);
+    /* (s, t) = (0.25, 0.25): both halves below 0.5 */
+    cdl_vec3 c = cdl_texture_eval(&t, 0, 0.25f, 0.75f);
+    float f = cdl_texture_eval1(&t, 0, 0.25f, 0.75f);
+    CHECK(near3(c, t.a, 1e-6f) && fabsf(f - 0.3f) < 1e-6f,
+          "checkerboard: color0 where the halves agree (%g), its scalar value color1 (%g)", (double)c.x, (double)f);
+    c = cdl_texture_eval(&t, 0, 0.75f, 0.75f);
+    f = cdl_texture_eval1(&t, 0, 0.75f, 0.75f);
+    CHECK(near3(c, t.b, 1e-6f) && fabsf(f - 0.05f) < 1e-6f, "checkerboard: and the other way round (%g, %g)",
+          (double)c.x, (double)f);
+}
+
+/* A surface of the xy plane, uv = (x, y), normal +z. */
+static cdl_surface plane(uint32_t mat)
+{
+    cdl_surface sf;
+    memset(&sf, 0, sizeof sf);
+    sf.ng = sf.ns = cdl_v3(0, 0, 1);
+    sf.dpdu = cdl_v3(1, 0, 0);
+    sf.dpdv = cdl_v3(0, 1, 0);
+    sf.u = 0.5f;
+    sf.v = 0.5f;
+    sf.mat = mat;
+    return sf;
+}
+
+static void bump(void)
+{
+    cdl_texture texs[1] = {grey(8, 8, ramp)};
+    float g[2];
+    cdl_texture_grad1(texs, 0, 0.5f, 0.5f, g);
+    /* 0.1 per texel, 8 texels per unit of u */
+    CHECK(fabsf(g[0] - 0.8f) < 1e-4f && fabsf(g[1]) < 1e-6f, "gradient of the ramp (%g, %g) (0.8, 0)", (double)g[0],
+          (double)g[1]);
+    cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
+    m.maps.on = 1;
+    m.maps.bump_tex = 0;
+    m.maps.bump_scale = 0.5f;
+    cdl_scene s;
+    memset(&s, 0, sizeof s);
+    s.mats = &m;
+    s.nmats = 1;
+    s.texs = texs;
+    s.ntexs = 1;
+    cdl_surface sf = plane(0);
+    cdl_surface_shade(&s, &sf, cdl_v3(0, 0, 1));
+    /* height h = 0.4 u: the normal of z = 0.4 u tilts by atan(0.4) towards -x */
+    float angle = acosf(cdl_dot(sf.ns, sf.nb)), want = atanf(0.4f);
+    CHECK(fabsf(angle - want) < 1e-4f && sf.ns.x < 0.0f && fabsf(sf.ns.y) < 1e-6f,
+          "bump map of a linear height tilts the normal by %g rad (atan 0.4 = %g) towards -x", (double)angle,
+          (double)want);
+    cdl_bsdf b;
+    cdl_scene_bsdf(&s, &sf, &b);
+    CHECK(b.perturbed && fabsf(cdl_dot(b.frame.n, b.frame.t)) < 1e-6f, "the BSDF's frame is the perturbed one");
+    cdl_texture_free(&texs[0]);
+}
+
+static void identity_normal_map(void)
+{
+    cdl_texture texs[1];
+    cdl_texture_init(&texs[0], CDL_TEX_CONST);
+    texs[0].a = cdl_v3(0.5f, 0.5f, 1.0f);
+    cdl_material m[2];
+    m[0] = cdl_material_default(CDL_MAT_CONDUCTOR);
+    m[0].alpha_x = 0.25f;
+    m[0].alpha_y = 0.05f;
+    m[1] = m[0];
+    m[1].maps.on = 1;
+    m[1].maps.normal_tex = 0;
+    cdl_scene s;
+    memset(&s, 0, sizeof s);
+    s.mats = m;
+    s.nmats = 2;
+    s.texs = texs;
+    s.ntexs = 1;
+    /* a tilted, non-orthogonal parameterization */
+    cdl_surface a = plane(0), b = plane(1);
+    a.dpdu = b.dpdu = cdl_v3(0.6f, 0.8f, 0.0f);
+    a.dpdv = b.dpdv = cdl_v3(-0.3f, 0.5f, 0.0f);
+    cdl_vec3 wo = cdl_normalize(cdl_v3(0.3f, -0.2f, 0.9f));
+    cdl_surface_shade(&s, &a, wo);
+    cdl_surface_shade(&s, &b, wo);
+    cdl_bsdf ba, bb;
+    cdl_scene_bsdf(&s, &a, &ba);
+    cdl_scene_bsdf(&s, &b, &bb);
+    CHECK(near3(ba.frame.t, bb.frame.t, 1e-6f) && near3(ba.frame.n, bb.frame.n, 1e-6f) && !bb.perturbed,
+          "identity normal map: the same frame (tangent along dp/du: %.3f %.3f %.3f)", (double)ba.frame.t.x,
+          (double)ba.frame.t.y, (double)ba.frame.t.z);
+    float worst = 0.0f;
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 7, 0);
+    for (int i = 0; i < 200; i++) {
+        cdl_vec3 wi = cdl_sample_cosine_hemisphere(cdl_rng_float(&rng), cdl_rng_float(&rng));
+        cdl_vec3 fa = cdl_bsdf_eval(&ba, wo, wi, 0), fb = cdl_bsdf_eval(&bb, wo, wi, 0);
+        float d = fabsf(fa.x - fb.x) / (fabsf(fa.x) + 1e-3f);
+        worst = d > worst ? d : worst;
+    }
+    CHECK(worst < 1e-5f, "identity normal map: the same f (worst relative difference %g)", (double)worst);
+    /* and the anisotropic lobe follows dp/du: swapping the roughnesses changes f */
+    cdl_bsdf bc = ba;
+    bc.ax = ba.ay;
+    bc.ay = ba.ax;
+    cdl_vec3 wi = cdl_reflect(wo, cdl_v3(0, 0, 1));
+    wi = cdl_normalize(cdl_add(wi, cdl_scale(ba.frame.t, 0.3f)));
+    CHECK(fabsf(cdl_bsdf_eval(&ba, wo, wi, 0).x - cdl_bsdf_eval(&bc, wo, wi, 0).x) > 1e-3f,
+          "the anisotropic lobe is oriented by the tangent");
+}
+
+int main(void)
+{
+    lookups();
+    checker();
+    bump();
+    identity_normal_map();
+    if (test_failures)
+        printf("%d check(s) failed\n", test_failures);
+    return test_failures != 0;
+}
