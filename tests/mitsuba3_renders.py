@@ -28,6 +28,7 @@ import OpenImageIO as oiio
 
 PASSING = [
     "floating_sphere/test_directional_direct.xml",
+    "instancing/test_instancing_path.xml",
 ]
 
 # the measured reason each other scene fails (README, "Mitsuba 3 render tests")
