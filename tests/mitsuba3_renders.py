@@ -42,6 +42,7 @@ PASSING = [
     "bsdf_spheres/test_textured_roughconductor_path.xml",
     "floating_sphere/test_directional_direct.xml",
     "infinite_mirrors/scene_path.xml",
+    "instancing/test_instancing_path.xml",
     "participating_media/test_surf_area_light_volpath.xml",
 ]
 

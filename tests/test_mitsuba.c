@@ -331,6 +331,71 @@ static void nested_ids(void)
     cdl_scene_free(&s);
 }
 
+/* A shapegroup placed by two instances: Embree instances, not copies; an
+ * emitter inside is dropped with a warning; an instance of something that
+ * is not a shapegroup is an error naming its line. */
+static int group_warnings;
+
+static void on_group_warning(void *user, const char *file, int line, const char *msg)
+{
+    (void)user;
+    (void)file;
+    group_warnings += line == 4 && strstr(msg, "shapegroup") != NULL;
+}
+
+static void instancing(void)
+{
+    write_file("inst.xml",
+               "<scene version=\"3.0.0\">\n" LIGHT
+               "<shape type=\"shapegroup\" id=\"g\"><shape type=\"rectangle\"/>\n"
+               "<shape type=\"sphere\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter>"
+               "<point name=\"center\" x=\"0\" y=\"0\" z=\"3\"/></shape></shape>\n"
+               "<shape type=\"instance\"><ref id=\"g\"/></shape>\n"
+               "<shape type=\"instance\"><ref id=\"g\"/><transform name=\"to_world\"><scale value=\"2\"/>"
+               "<translate x=\"10\"/></transform></shape>\n"
+               "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    const cdl_log_sink sink = {on_group_warning, NULL, 0};
+    const cdl_log_sink *prev = cdl_log_push(&sink);
+    int rc = load("inst.xml", &s, &set);
+    cdl_log_pop(prev);
+    CHECK(rc == 0 && s.ntris == 0 && s.nspheres == 0 && s.ngroups == 1 && s.ninsts == 2 && s.nlights == 1,
+          "a shapegroup and 2 instances: %u groups, %u instances, no top-level shapes, only the point light (%u)",
+          s.ngroups, s.ninsts, s.nlights);
+    CHECK(group_warnings == 1, "the emitter in the shapegroup is dropped with a warning at its line");
+    if (!rc) {
+        cdl_hit h;
+        cdl_surface sf;
+        memset(&sf, 0, sizeof sf);
+        int hit = cdl_intersect(&s, cdl_v3(10.5f, 0.5f, -5.0f), cdl_v3(0, 0, 1), 100.0f, &h);
+        if (hit)
+            cdl_surface_at(&s, &h, &sf);
+        CHECK(hit && h.inst == 1 && fabsf(sf.p.z) < 1e-5f && fabsf(sf.ng.z) > 0.9999f,
+              "the second instance's rectangle is hit at (%g %g %g)", (double)sf.p.x, (double)sf.p.y,
+              (double)sf.p.z);
+        hit = cdl_intersect(&s, cdl_v3(10.0f, 0.0f, 20.0f), cdl_v3(0, 0, -1), 100.0f, &h);
+        if (hit)
+            cdl_surface_at(&s, &h, &sf);
+        CHECK(hit && h.inst == 1 && h.geom == CDL_GEOM_SPHERES && fabsf(sf.p.z - 8.0f) < 1e-4f,
+              "its sphere (centre z 3, radius 1, scaled 2) is hit at z = %g (8)", (double)sf.p.z);
+    }
+    cdl_scene_free(&s);
+    write_file("inst_bad.xml", "<scene version=\"3.0.0\">\n" LIGHT "<bsdf type=\"diffuse\" id=\"d\"/>\n"
+                               "<shape type=\"instance\">\n<ref id=\"d\"/></shape>\n</scene>\n");
+    const cdl_log_sink quiet = {NULL, NULL, 1};
+    prev = cdl_log_push(&quiet);
+    char path[512];
+    snprintf(path, sizeof path, "%s/inst_bad.xml", dir);
+    cdl_error err;
+    rc = cdl_scene_init(&s, path, &err);
+    if (!rc)
+        rc = cdl_scene_load(&s, path, &set, &err);
+    cdl_log_pop(prev);
+    CHECK(rc != 0 && err.line == 5, "an instance of a bsdf is an error at its <ref> (line %d)", err.line);
+    cdl_scene_free(&s);
+}
+
 /* A cylinder from p0 to p1 (along x) of radius 0.5: its area and normals
  * outwards, inwards with flip_normals. */
 static void cylinder(void)
@@ -575,6 +640,7 @@ int main(int argc, char **argv)
     cylinder();
     nested_ids();
     textures_and_maps();
+    instancing();
     envmap_orientation();
     if (argc > 1)
         shared_scenes(argv[1]);

@@ -244,13 +244,26 @@ static void test_instancing(void)
              LIGHT);
     write_file("inst.pbrt", text);
     int rc = load("inst.pbrt", &s, &set, &err);
-    CHECK(rc == 0 && s.ntris == 6 && s.nverts == 12, "3 instances of a 2-triangle object: %u triangles, %u vertices",
-          s.ntris, s.nverts);
+    /* Embree instances of one group: no copies of the object's triangles */
+    CHECK(rc == 0 && s.ntris == 0 && s.nverts == 4 && s.ngroups == 1 && s.ninsts == 3,
+          "3 instances of a 2-triangle object: %u top-level triangles, %u vertices, %u groups, %u instances", s.ntris,
+          s.nverts, s.ngroups, s.ninsts);
     if (!rc) {
-        CHECK(near3(vert(&s, 5), cdl_v3(11, 0, 1), 1e-6f), "instance 2 vertex 1 = (%g %g %g), expected (11 0 1)",
-              V3(vert(&s, 5)));
-        CHECK(near3(vert(&s, 10), cdl_v3(2, 2, 2), 1e-6f), "instance 3 vertex 2 = (%g %g %g), expected (2 2 2)",
-              V3(vert(&s, 10)));
+        /* straight up onto each instance (from below: the Scale 2 one covers the first): object z = 1 as
+         * it is, under Translate 10 and under Scale 2 */
+        const float xs[3][3] = {{0.5f, 0.5f, 1.0f}, {10.5f, 0.5f, 1.0f}, {1.5f, 1.5f, 2.0f}};
+        for (int i = 0; i < 3; i++) {
+            cdl_hit h;
+            cdl_surface sf;
+            memset(&sf, 0, sizeof sf);
+            int hit = cdl_intersect(&s, cdl_v3(xs[i][0], xs[i][1], -5.0f), cdl_v3(0, 0, 1), 100.0f, &h);
+            if (hit)
+                cdl_surface_at(&s, &h, &sf);
+            CHECK(hit && h.inst != CDL_NO_INST && near3(sf.p, cdl_v3(xs[i][0], xs[i][1], xs[i][2]), 1e-5f) &&
+                      fabsf(sf.ng.z) > 0.9999f,
+                  "instance %d is hit at (%g %g %g), expected z = %g", i, V3(sf.p), (double)xs[i][2]);
+        }
+        CHECK(near3(s.bmax, cdl_v3(11, 2, 2), 1e-6f), "bounds reach (%g %g %g), expected (11 2 2)", V3(s.bmax));
     }
     cdl_scene_free(&s);
 }

@@ -19,14 +19,14 @@
 
 #define CDL_MTS_MAX_INCLUDE 16
 
-typedef enum cdl_mts_kind { CDL_MTS_BSDF, CDL_MTS_TEXTURE, CDL_MTS_OTHER } cdl_mts_kind;
+typedef enum cdl_mts_kind { CDL_MTS_BSDF, CDL_MTS_TEXTURE, CDL_MTS_OTHER, CDL_MTS_SHAPEGROUP } cdl_mts_kind;
 
 /* An object declared with an id, for <ref id="..."/>. */
 typedef struct cdl_mts_id {
     char *id;
     cdl_mts_kind kind;
     int32_t mat;    /* bsdf: scene material, or -1 for a surface that is not there (null) */
-    int tex;        /* texture: scene texture or -1 for a constant */
+    int tex;        /* texture: scene texture or -1 for a constant; shapegroup: the scene's shape group */
     cdl_vec3 value; /* texture: constant value or the bitmap's scale */
 } cdl_mts_id;
 
@@ -54,6 +54,7 @@ typedef struct cdl_mts_ctx {
     int npaths;
     int saw_sensor;
     uint32_t nshapes;
+    int in_group;           /* reading the shapes of a shapegroup */
     char buf[4096];         /* an attribute after $variable substitution */
 } cdl_mts_ctx;
 

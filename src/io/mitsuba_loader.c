@@ -340,7 +340,7 @@ int cdl_load_mitsuba(cdl_scene *s, const char *path, const char (*defs)[CDL_DEFI
         shorter_axis_fov(c, 0, 45.0, "x", 768, 576, &f);
         set->fov = (float)f;
     }
-    if (!rc && s->ntris == 0 && s->nspheres == 0)
+    if (!rc && s->ntris == 0 && s->nspheres == 0 && s->ninsts == 0)
         rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0,
                            c->nshapes ? "scene has no (non-degenerate) geometry" : "scene has no geometry (no <shape>)");
     for (int i = 0; i < c->nvars; i++) {

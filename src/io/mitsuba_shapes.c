@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/instance.h"
 #include "scene/mesh.h"
 #include "io/mitsuba_internal.h"
 #include "io/obj_loader.h"
@@ -158,6 +159,71 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
     return 0;
 }
 
+/* <shape type="shapegroup" id="...">: its shapes, in object space, become
+ * a scene shape group that <shape type="instance"> places. */
+static int shapegroup(cdl_mts_ctx *c, cdl_xml_node *n)
+{
+    int rc = 0;
+    const char *a = cdl_mts_attr(c, n, "id", &rc);
+    if (rc)
+        return rc;
+    if (!a || !*a)
+        return cdl_mts_error(c, n->line, "a shapegroup needs an id for its instances to refer to");
+    if (c->in_group)
+        return cdl_mts_error(c, n->line, "shapegroups do not nest (as in Mitsuba)");
+    char id[256];
+    snprintf(id, sizeof id, "%s", a);
+    uint32_t group;
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_group_begin(c->s, &group, c->err))))
+        return rc;
+    cdl_mts_id v = {id, CDL_MTS_SHAPEGROUP, -1, (int)group, cdl_v3(0, 0, 0)};
+    c->in_group = 1;
+    for (int i = 0; i < n->nkids && !rc; i++) {
+        cdl_xml_node *k = &n->kids[i];
+        if (!strcmp(k->name, "shape")) {
+            k->used = 1;
+            rc = cdl_mts_shape(c, k);
+        }
+    }
+    c->in_group = 0;
+    if (rc)
+        return rc;
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_group_end(c->s, c->err))))
+        return rc;
+    cdl_mts_warn_unused(c, n, "shape \"shapegroup\"");
+    return cdl_mts_add_id(c, n, &v);
+}
+
+/* <shape type="instance">: a <ref> to a shapegroup and a to_world. */
+static int instance(cdl_mts_ctx *c, cdl_xml_node *n)
+{
+    if (c->in_group)
+        return cdl_mts_error(c, n->line, "an instance inside a shapegroup (Mitsuba does not nest instancing)");
+    const cdl_mts_id *g = NULL;
+    int rc = 0;
+    for (int i = 0; i < n->nkids && !rc; i++) {
+        cdl_xml_node *k = &n->kids[i];
+        if (strcmp(k->name, "ref"))
+            continue;
+        k->used = 1;
+        const char *id = cdl_mts_attr(c, k, "id", &rc);
+        if (rc)
+            return rc;
+        if (g)
+            return cdl_mts_error(c, k->line, "an instance refers to one shapegroup");
+        if (!id || !(g = cdl_mts_find_id(c, id)) || g->kind != CDL_MTS_SHAPEGROUP)
+            return cdl_mts_error(c, k->line, "instance: \"%s\" is not a shapegroup declared before", id ? id : "");
+    }
+    if (!g)
+        return cdl_mts_error(c, n->line, "an instance needs a <ref id=\"...\"/> to a shapegroup");
+    cdl_mat4 m;
+    if ((rc = cdl_mts_transform(c, n, "to_world", &m)))
+        return rc;
+    cdl_mts_warn_unused(c, n, "shape \"instance\"");
+    c->nshapes++;
+    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_instance(c->s, (uint32_t)g->tex, &m, c->err));
+}
+
 /* The shape's surface: a nested <bsdf>, a <ref> to one, or Mitsuba's default. */
 static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
@@ -172,6 +238,10 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
     if (rc)
         return rc;
     n->used = 1;
+    if (!strcmp(type, "shapegroup"))
+        return shapegroup(c, n);
+    if (!strcmp(type, "instance"))
+        return instance(c, n);
     static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder"};
     size_t kind = 0;
     while (kind < sizeof known / sizeof known[0] && strcmp(type, known[kind]))
@@ -191,6 +261,14 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         if (!strcmp(n->kids[i].name, "emitter")) {
             if (emit >= 0)
                 return cdl_mts_error(c, n->kids[i].line, "a shape has one area emitter");
+            if (c->in_group) { /* Mitsuba refuses these; pbrt-v4 drops them with a warning, as here */
+                cdl_mts_warn(c, n->kids[i].line, "an emitter on a shape in a shapegroup is not instanced: the shape "
+                                                 "does not emit");
+                n->kids[i].used = 1;
+                for (int j = 0; j < n->kids[i].nkids; j++)
+                    n->kids[i].kids[j].used = 1;
+                continue;
+            }
             rc = cdl_mts_area(c, &n->kids[i], &emit);
         }
     if (rc)

@@ -39,19 +39,9 @@ typedef struct cdl_pbrt_shape {
     cdl_mesh mesh; /* in object space, validated */
 } cdl_pbrt_shape;
 
-typedef struct cdl_pbrt_inst_shape {
-    cdl_pbrt_shape shape;
-    cdl_mat4 ctm;
-    int reverse;
-    int32_t mat;
-    int line;
-    char *file;
-} cdl_pbrt_inst_shape;
-
 typedef struct cdl_pbrt_object {
     char *name;
-    cdl_pbrt_inst_shape *shapes;
-    uint32_t n, cap;
+    uint32_t group; /* the scene's shape group */
 } cdl_pbrt_object;
 
 typedef enum cdl_pbrt_tex_kind { CDL_PBRT_TEX_CONST, CDL_PBRT_TEX_IMAGE, CDL_PBRT_TEX_OTHER } cdl_pbrt_tex_kind;
@@ -119,6 +109,10 @@ int cdl_pbrt_check_file(cdl_pbrt_ctx *c, const char *what, const char *path);
 
 /* pbrt_shapes.c */
 int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type);
+/* ObjectBegin name / ObjectEnd: the shapes between become a scene shape
+ * group; ObjectInstance places it under the current transform. */
+int cdl_pbrt_object_begin(cdl_pbrt_ctx *c, const char *name);
+int cdl_pbrt_object_end(cdl_pbrt_ctx *c);
 int cdl_pbrt_object_instance(cdl_pbrt_ctx *c, const char *name);
 void cdl_pbrt_shape_free(cdl_pbrt_shape *sh);
 

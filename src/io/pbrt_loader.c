@@ -526,7 +526,8 @@ static int directive(cdl_pbrt_ctx *c, word w)
             cdl_pbrt_warn(c, c->line, "WorldEnd closes the %s of %s:%d", block_name(g->kind), g->file,
                           g->line);
         }
-        c->cur_obj = -1;
+        if (c->cur_obj >= 0 && (rc = cdl_pbrt_object_end(c)))
+            return rc;
         c->world_done = 1;
         return 0;
     }
@@ -561,19 +562,8 @@ static int directive(cdl_pbrt_ctx *c, word w)
         if (c->cur_obj >= 0)
             return cdl_pbrt_error(c, c->line, "ObjectBegin \"%s\" inside the definition of \"%s\"", a,
                                   c->objs[c->cur_obj].name);
-        if (c->nobjs == c->capobjs) {
-            int cap = c->capobjs ? 2 * c->capobjs : 8;
-            cdl_pbrt_object *p = realloc(c->objs, sizeof *p * (size_t)cap);
-            if (!p)
-                return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
-            c->objs = p;
-            c->capobjs = cap;
-        }
-        cdl_pbrt_object *o = &c->objs[c->nobjs];
-        memset(o, 0, sizeof *o);
-        if (!(o->name = strdup(a)))
-            return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
-        c->cur_obj = c->nobjs++;
+        if ((rc = cdl_pbrt_object_begin(c, a)))
+            return rc;
         return push(c, CDL_PBRT_OBJECT); /* pbrt: ObjectBegin implies AttributeBegin */
     }
     if (is(w, "ObjectEnd")) {
@@ -581,7 +571,8 @@ static int directive(cdl_pbrt_ctx *c, word w)
             return rc;
         if (c->cur_obj < 0)
             return cdl_pbrt_error(c, c->line, "ObjectEnd without ObjectBegin");
-        c->cur_obj = -1;
+        if ((rc = cdl_pbrt_object_end(c)))
+            return rc;
         return pop(c, CDL_PBRT_OBJECT, dir);
     }
     if (is(w, "ObjectInstance")) {
@@ -613,15 +604,8 @@ static void ctx_free(cdl_pbrt_ctx *c)
     for (int i = 0; i < c->ncs; i++)
         free(c->cs[i].name);
     free(c->cs);
-    for (int i = 0; i < c->nobjs; i++) {
-        cdl_pbrt_object *o = &c->objs[i];
-        for (uint32_t k = 0; k < o->n; k++) {
-            cdl_pbrt_shape_free(&o->shapes[k].shape);
-            free(o->shapes[k].file);
-        }
-        free(o->shapes);
-        free(o->name);
-    }
+    for (int i = 0; i < c->nobjs; i++)
+        free(c->objs[i].name);
     free(c->objs);
 }
 
@@ -695,11 +679,13 @@ int cdl_load_pbrt(cdl_scene *s, const char *path, cdl_scene_settings *set, cdl_e
         for (int i = c->nstack; i-- > 0;)
             cdl_warn(c->stack[i].file, c->stack[i].line, "%s is never closed",
                      block_name(c->stack[i].kind));
+        if (c->cur_obj >= 0)
+            rc = cdl_pbrt_object_end(c);
         if (!c->saw_camera) {
             cdl_mat4 id = cdl_mat4_identity();
             set_camera(c, &id, 90.0);
         }
-        if (s->ntris == 0 && s->nspheres == 0)
+        if (!rc && s->ntris == 0 && s->nspheres == 0 && s->ninsts == 0)
             rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0,
                                c->nshapes ? "scene has no (non-degenerate) geometry"
                                           : "scene has no geometry (no Shape)");

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+#include "scene/instance.h"
 #include "scene/mesh.h"
 #include "scene/subdiv.h"
 #include "io/ply.h"
@@ -296,40 +297,14 @@ int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
         cdl_pbrt_shape_free(&sh);
         return rc;
     }
-    if (c->cur_obj >= 0) {
-        /* kept in object space, instanced by ObjectInstance */
-        cdl_pbrt_object *o = &c->objs[c->cur_obj];
-        if (c->gs.area && !c->warned_inst_light) {
-            cdl_pbrt_warn(c, c->line, "area lights inside ObjectBegin are not supported (as in pbrt-v3): "
-                                      "the shapes do not emit");
-            c->warned_inst_light = 1;
-        }
-        if (o->n == o->cap) {
-            uint32_t cap = o->cap ? 2 * o->cap : 8;
-            cdl_pbrt_inst_shape *p = realloc(o->shapes, sizeof *p * cap);
-            if (!p) {
-                cdl_pbrt_shape_free(&sh);
-                return oom(c);
-            }
-            o->shapes = p;
-            o->cap = cap;
-        }
-        cdl_pbrt_inst_shape *r = &o->shapes[o->n];
-        r->shape = sh;
-        r->ctm = c->gs.ctm;
-        r->reverse = c->gs.reverse;
-        r->mat = mat;
-        r->line = c->line;
-        r->file = strdup(c->file);
-        if (!r->file) {
-            cdl_pbrt_shape_free(&sh);
-            return oom(c);
-        }
-        o->n++;
-        return 0;
+    if (c->cur_obj >= 0 && c->gs.area && !c->warned_inst_light) {
+        /* the shapes go to the object's shape group, which does not emit */
+        cdl_pbrt_warn(c, c->line, "area lights inside ObjectBegin are not supported (as in pbrt-v3 and v4): "
+                                  "the shapes do not emit");
+        c->warned_inst_light = 1;
     }
     int32_t emit = -1;
-    if (c->gs.area)
+    if (c->gs.area && c->cur_obj < 0)
         rc = cdl_pbrt_scene_rc(c, cdl_scene_add_emitter(c->s, c->gs.area_L, c->gs.area_twosided, &emit, c->err));
     if (!rc)
         rc = emit_shape(c, &sh, &c->gs.ctm, c->gs.reverse, cdl_mat4_swaps_handedness(&c->gs.ctm),
@@ -339,6 +314,33 @@ int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
     return rc;
 }
 
+int cdl_pbrt_object_begin(cdl_pbrt_ctx *c, const char *name)
+{
+    if (c->nobjs == c->capobjs) {
+        int cap = c->capobjs ? 2 * c->capobjs : 8;
+        cdl_pbrt_object *p = realloc(c->objs, sizeof *p * (size_t)cap);
+        if (!p)
+            return oom(c);
+        c->objs = p;
+        c->capobjs = cap;
+    }
+    cdl_pbrt_object *o = &c->objs[c->nobjs];
+    memset(o, 0, sizeof *o);
+    int rc = cdl_pbrt_scene_rc(c, cdl_scene_group_begin(c->s, &o->group, c->err));
+    if (rc)
+        return rc;
+    if (!(o->name = strdup(name)))
+        return oom(c);
+    c->cur_obj = c->nobjs++;
+    return 0;
+}
+
+int cdl_pbrt_object_end(cdl_pbrt_ctx *c)
+{
+    c->cur_obj = -1;
+    return cdl_pbrt_scene_rc(c, cdl_scene_group_end(c->s, c->err));
+}
+
 int cdl_pbrt_object_instance(cdl_pbrt_ctx *c, const char *name)
 {
     int i = c->nobjs;
@@ -346,15 +348,6 @@ int cdl_pbrt_object_instance(cdl_pbrt_ctx *c, const char *name)
         ;
     if (i < 0)
         return cdl_pbrt_error(c, c->line, "ObjectInstance: object \"%s\" is not defined", name);
-    const cdl_pbrt_object *o = &c->objs[i];
-    for (uint32_t k = 0; k < o->n; k++) {
-        const cdl_pbrt_inst_shape *r = &o->shapes[k];
-        cdl_mat4 total = cdl_mat4_mul(&c->gs.ctm, &r->ctm);
-        int rc = emit_shape(c, &r->shape, &total, r->reverse, cdl_mat4_swaps_handedness(&r->ctm),
-                            (uint32_t)r->mat, -1);
-        if (rc)
-            return rc;
-        c->nshapes++;
-    }
-    return 0;
+    c->nshapes++;
+    return cdl_pbrt_scene_rc(c, cdl_scene_add_instance(c->s, c->objs[i].group, &c->gs.ctm, c->err));
 }

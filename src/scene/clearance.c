@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#include "scene/instance.h"
+
 typedef struct query_ctx {
     const cdl_scene *s;
     cdl_vec3 x, n;
@@ -44,18 +46,36 @@ static float tri_dist2(cdl_vec3 p, cdl_vec3 a, cdl_vec3 b, cdl_vec3 c)
     return cdl_dot(e, e);
 }
 
+static cdl_vec3 to_world(const cdl_instance *in, const float *p)
+{
+    const float *m = in ? in->xf : NULL;
+    if (!m)
+        return cdl_v3(p[0], p[1], p[2]);
+    return cdl_v3(m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + m[3], m[4] * p[0] + m[5] * p[1] + m[6] * p[2] + m[7],
+                  m[8] * p[0] + m[9] * p[1] + m[10] * p[2] + m[11]);
+}
+
+/* Distances are taken in world space (the query is a world-space one,
+ * whatever the instance's transform). */
 static bool visit(struct RTCPointQueryFunctionArguments *args)
 {
     const query_ctx *c = args->userPtr;
     const cdl_scene *s = c->s;
+    const cdl_instance *in = NULL;
+    const uint32_t *idx = s->idx;
+    const float *sph = s->sph;
+    if (args->context->instStackSize > 0) {
+        in = &s->insts[args->context->instID[0] - CDL_GEOM_INSTANCE0];
+        idx = s->groups[in->group].idx;
+        sph = s->groups[in->group].sph;
+    }
     float d2;
     if (args->geomID == CDL_GEOM_TRIANGLES) {
-        const uint32_t *t = &s->idx[3 * (size_t)args->primID];
+        const uint32_t *t = &idx[3 * (size_t)args->primID];
         cdl_vec3 v[3];
         int front = 0;
         for (int k = 0; k < 3; k++) {
-            const float *p = &s->pos[3 * (size_t)t[k]];
-            v[k] = cdl_v3(p[0], p[1], p[2]);
+            v[k] = to_world(in, &s->pos[3 * (size_t)t[k]]);
             front |= cdl_dot(cdl_sub(v[k], c->x), c->n) > c->tol;
         }
         /* a triangle wholly on or behind the plane blocks no segment
@@ -65,11 +85,19 @@ static bool visit(struct RTCPointQueryFunctionArguments *args)
             return false;
         d2 = tri_dist2(c->x, v[0], v[1], v[2]);
     } else {
-        const float *q = &s->sph[4 * (size_t)args->primID];
-        cdl_vec3 cs = cdl_v3(q[0], q[1], q[2]);
-        if (cdl_dot(cdl_sub(cs, c->x), c->n) + q[3] <= c->tol)
+        const float *q = &sph[4 * (size_t)args->primID];
+        cdl_vec3 cs = to_world(in, q);
+        float r = q[3];
+        if (in) { /* an ellipsoid in general: approximated by its bounding sphere */
+            const float *m = in->xf;
+            float l = 0.0f;
+            for (int k = 0; k < 3; k++)
+                l = cdl_maxf(l, sqrtf(m[k] * m[k] + m[4 + k] * m[4 + k] + m[8 + k] * m[8 + k]));
+            r *= l;
+        }
+        if (cdl_dot(cdl_sub(cs, c->x), c->n) + r <= c->tol)
             return false;
-        float d = fabsf(cdl_length(cdl_sub(c->x, cs)) - q[3]);
+        float d = fabsf(cdl_length(cdl_sub(c->x, cs)) - r);
         d2 = d * d;
     }
     if (d2 < args->query->radius * args->query->radius) {

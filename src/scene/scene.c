@@ -8,6 +8,7 @@
 #include "core/grow.h"
 #include "core/log.h"
 #include "scene/shading.h"
+#include "scene/instance.h"
 
 
 static void embree_error(void *user, enum RTCError code, const char *str)
@@ -20,6 +21,7 @@ int cdl_scene_init(cdl_scene *s, const char *path, cdl_error *err)
 {
     memset(s, 0, sizeof *s);
     snprintf(s->path, sizeof s->path, "%s", path ? path : "");
+    s->open_group = -1;
     s->device = rtcNewDevice(NULL);
     if (!s->device)
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "cannot create Embree device (error %d)",
@@ -32,6 +34,7 @@ void cdl_scene_free(cdl_scene *s)
 {
     if (s->rtc)
         rtcReleaseScene(s->rtc);
+    cdl_instances_free(s);
     if (s->device)
         rtcReleaseDevice(s->device);
     free(s->pos);
@@ -404,7 +407,9 @@ static void skip_target_sphere(const struct RTCFilterFunctionNArguments *args)
 
 int cdl_scene_commit(cdl_scene *s, cdl_error *err)
 {
-    if (s->ntris == 0 && s->nspheres == 0)
+    if (s->open_group >= 0)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "a shape group is still open");
+    if (s->ntris == 0 && s->nspheres == 0 && s->ninsts == 0)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "scene has no (non-degenerate) triangles");
     cdl_vec3 lo = cdl_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = cdl_scale(lo, -1.0f);
     for (uint32_t i = 0; i < 3 * s->ntris; i++) {
@@ -417,6 +422,7 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
         lo = cdl_v3(fminf(lo.x, q[0] - q[3]), fminf(lo.y, q[1] - q[3]), fminf(lo.z, q[2] - q[3]));
         hi = cdl_v3(fmaxf(hi.x, q[0] + q[3]), fmaxf(hi.y, q[1] + q[3]), fmaxf(hi.z, q[2] + q[3]));
     }
+    cdl_instances_bounds(s, &lo, &hi);
     s->bmin = lo;
     s->bmax = hi;
     s->eps = 1e-6f * cdl_max3(cdl_sub(hi, lo));
@@ -453,6 +459,8 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
         rtcAttachGeometryByID(s->rtc, g, CDL_GEOM_SPHERES);
         rtcReleaseGeometry(g);
     }
+    if ((rc = cdl_instances_commit(s, err)))
+        return rc;
     rtcCommitScene(s->rtc);
     enum RTCError e = rtcGetDeviceError(s->device);
     if (e != RTC_ERROR_NONE)
@@ -508,15 +516,14 @@ static void tri_partials(const float *p0, const float *p1, const float *p2, cons
     sf->dpdv = cdl_scale(cdl_sub(cdl_scale(e1, du0), cdl_scale(e0, du1)), inv);
 }
 
-static void sphere_surface(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+void cdl_sphere_surface(const float *q, int inward, cdl_vec3 ng, cdl_surface *sf)
 {
-    const float *q = s->sph + 4 * (size_t)h->prim;
     cdl_vec3 c = cdl_v3(q[0], q[1], q[2]);
-    cdl_vec3 n = cdl_normalize(h->ng);
-    if (s->sph_inward[h->prim])
+    cdl_vec3 n = cdl_normalize(ng);
+    if (inward)
         n = cdl_neg(n);
     /* the point on the analytic surface, not o + t d with its rounding */
-    cdl_vec3 out = s->sph_inward[h->prim] ? cdl_neg(n) : n;
+    cdl_vec3 out = inward ? cdl_neg(n) : n;
     sf->p = cdl_madd(c, out, q[3]);
     sf->ng = sf->ns = n;
     sf->u = 0.5f + atan2f(out.z, out.x) * (0.5f * CDL_INV_PI);
@@ -526,36 +533,27 @@ static void sphere_surface(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf
     float cp = st > 0.0f ? out.x / st : 1.0f, sp = st > 0.0f ? out.z / st : 0.0f;
     sf->dpdu = cdl_scale(cdl_v3(-st * sp, 0.0f, st * cp), 2.0f * CDL_PI * r);
     sf->dpdv = cdl_scale(cdl_v3(out.y * cp, -st, out.y * sp), CDL_PI * r);
-    sf->prim = h->prim;
     sf->geom = CDL_GEOM_SPHERES;
-    sf->mat = s->sph_mat[h->prim];
-    sf->light = s->sph_light[h->prim];
 }
 
-void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1, float b2,
+                          cdl_surface *sf)
 {
-    if (h->geom == CDL_GEOM_SPHERES) {
-        sphere_surface(s, h, sf);
-        cdl_surface_shade(s, sf, cdl_neg(h->d));
-        return;
-    }
-    const uint32_t *t = s->idx + 3 * (size_t)h->prim;
-    float b0 = 1.0f - h->b1 - h->b2;
+    float b0 = 1.0f - b1 - b2;
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
                 *p2 = s->pos + 3 * (size_t)t[2];
     /* Barycentric position: closer to the surface than o + t d. */
-    sf->p = cdl_v3(b0 * p0[0] + h->b1 * p1[0] + h->b2 * p2[0],
-                   b0 * p0[1] + h->b1 * p1[1] + h->b2 * p2[1],
-                   b0 * p0[2] + h->b1 * p1[2] + h->b2 * p2[2]);
-    sf->ng = s->face_n[h->prim];
+    sf->p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0],
+                   b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
+                   b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
+    sf->ng = face_n;
     sf->ns = sf->ng;
-    uint8_t fl = s->tri_flags[h->prim];
     if (fl & CDL_TRI_HAS_N) {
         const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
                     *n2 = s->nrm + 3 * (size_t)t[2];
-        cdl_vec3 n = cdl_v3(b0 * n0[0] + h->b1 * n1[0] + h->b2 * n2[0],
-                            b0 * n0[1] + h->b1 * n1[1] + h->b2 * n2[1],
-                            b0 * n0[2] + h->b1 * n1[2] + h->b2 * n2[2]);
+        cdl_vec3 n = cdl_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0],
+                            b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
+                            b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
         float len = cdl_length(n);
         if (len > 1e-12f && isfinite(len))
             sf->ns = cdl_scale(n, 1.0f / len);
@@ -565,14 +563,30 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
     if (fl & CDL_TRI_HAS_UV) {
         const float *u0 = s->uv + 2 * (size_t)t[0], *u1 = s->uv + 2 * (size_t)t[1],
                     *u2 = s->uv + 2 * (size_t)t[2];
-        sf->u = b0 * u0[0] + h->b1 * u1[0] + h->b2 * u2[0];
-        sf->v = b0 * u0[1] + h->b1 * u1[1] + h->b2 * u2[1];
+        sf->u = b0 * u0[0] + b1 * u1[0] + b2 * u2[0];
+        sf->v = b0 * u0[1] + b1 * u1[1] + b2 * u2[1];
         tri_partials(p0, p1, p2, u0, u1, u2, sf);
     }
-    sf->prim = h->prim;
     sf->geom = CDL_GEOM_TRIANGLES;
-    sf->mat = s->tri_mat[h->prim];
-    sf->light = s->tri_light[h->prim];
+}
+
+/* The surface at a hit, world space, with the material's maps applied
+ * for the viewing direction (one shading frame for every method). */
+void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+{
+    if (h->inst != CDL_NO_INST) {
+        cdl_instance_surface(s, h, sf);
+    } else if (h->geom == CDL_GEOM_SPHERES) {
+        cdl_sphere_surface(s->sph + 4 * (size_t)h->prim, s->sph_inward[h->prim], h->ng, sf);
+        sf->mat = s->sph_mat[h->prim];
+        sf->light = s->sph_light[h->prim];
+    } else {
+        cdl_triangle_surface(s, s->idx + 3 * (size_t)h->prim, s->tri_flags[h->prim], s->face_n[h->prim], h->b1,
+                             h->b2, sf);
+        sf->mat = s->tri_mat[h->prim];
+        sf->light = s->tri_light[h->prim];
+    }
+    sf->prim = h->prim;
     cdl_surface_shade(s, sf, cdl_neg(h->d));
 }
 

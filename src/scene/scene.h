@@ -1,5 +1,6 @@
 /* The scene: one triangle soup in one Embree geometry (primID = triangle
- * index), materials, textures and lights. Loaders fill it through the
+ * index), analytic spheres, instances of shape groups (instance.h),
+ * materials, textures and lights. Loaders fill it through the
  * cdl_scene_add_* calls, then cdl_scene_commit validates it and builds
  * the BVH, the light list and the light-selection table. */
 #ifndef CDL_SCENE_H
@@ -54,6 +55,9 @@ typedef struct cdl_scene_settings {
 } cdl_scene_settings;
 
 
+typedef struct cdl_group cdl_group;       /* scene/instance.h */
+typedef struct cdl_instance cdl_instance;
+
 /* Also the public API's scene handle (candela.h). */
 typedef struct cdl_scene {
     RTCDevice device;
@@ -77,6 +81,14 @@ typedef struct cdl_scene {
     int32_t *sph_emit;
     uint8_t *sph_inward; /* ReverseOrientation: normals (and emission) point inwards */
     int32_t *sph_light;  /* after commit */
+
+    /* shape groups (object space; their vertices live in pos/nrm/uv) and
+     * their instances, geometries CDL_GEOM_INSTANCE0 + i (instance.h) */
+    cdl_group *groups;
+    uint32_t ngroups, cap_groups;
+    int32_t open_group; /* the group shapes are added to, or -1 */
+    cdl_instance *insts;
+    uint32_t ninsts, cap_insts;
 
     cdl_emitter *emitters;
     uint32_t nemitters, cap_emitters;
@@ -134,18 +146,22 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err);
 
 /* ---- ray queries ---- */
 
-enum { CDL_GEOM_TRIANGLES = 0, CDL_GEOM_SPHERES = 1 };
+/* Geometry ids in the top-level Embree scene (and, for the first two,
+ * in each group's scene); instance i is CDL_GEOM_INSTANCE0 + i. */
+enum { CDL_GEOM_TRIANGLES = 0, CDL_GEOM_SPHERES = 1, CDL_GEOM_INSTANCE0 = 2 };
+#define CDL_NO_INST UINT32_MAX
 
 typedef struct cdl_hit {
     float t, b1, b2; /* distance and barycentrics of vertices 1 and 2 */
-    uint32_t prim;   /* triangle or sphere index */
-    uint32_t geom;   /* CDL_GEOM_* */
-    cdl_vec3 ng;     /* Embree's unnormalized geometric normal */
+    uint32_t prim;   /* triangle or sphere index (in the group, for an instance) */
+    uint32_t geom;   /* CDL_GEOM_TRIANGLES or CDL_GEOM_SPHERES */
+    uint32_t inst;   /* instance index or CDL_NO_INST */
+    cdl_vec3 ng;     /* Embree's unnormalized geometric normal (object space in an instance) */
     cdl_vec3 d;      /* the ray's direction (a view-dependent shading frame reads it) */
 } cdl_hit;
 
 typedef struct cdl_surface {
-    cdl_vec3 p, ng, ns; /* ng: unit CCW normal; ns: shading normal (after bump/normal maps) */
+    cdl_vec3 p, ng, ns; /* world space; ng: unit CCW normal; ns: shading normal (after bump/normal maps) */
     cdl_vec3 ts;        /* shading tangent along dp/du (perpendicular to ns), or zero: any */
     cdl_vec3 nb;        /* shading normal before bump/normal maps (== ns without) */
     cdl_vec3 dpdu, dpdv; /* partials of p over (u, v), zero without uv */
@@ -180,6 +196,7 @@ static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, floa
     rh.ray.flags = 0;
     rh.ray.time = 0.0f;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
@@ -188,6 +205,7 @@ static inline int cdl_intersect(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, floa
     h->b2 = rh.hit.v;
     h->prim = rh.hit.primID;
     h->geom = rh.hit.geomID;
+    h->inst = rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? CDL_NO_INST : rh.hit.instID[0] - CDL_GEOM_INSTANCE0;
     h->ng = cdl_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     h->d = d;
     return 1;
