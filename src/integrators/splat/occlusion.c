@@ -188,7 +188,7 @@ uint32_t splat_occl_filter(const splat_state *s, const cdl_photon_ray *r, uint32
     }
     cdl_shadow_ctx sc;
     rtcInitIntersectContext(&sc.ctx);
-    sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sc.ctx.flags = s->scene->ninsts ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     sc.skip_sphere = UINT32_MAX;
     rtcOccluded16(valid, s->scene->rtc, &sc.ctx, &p);
     for (uint32_t i = 0; i < 16; i++)
