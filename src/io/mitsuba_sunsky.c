@@ -39,13 +39,20 @@ static cdl_xml_node *peek(cdl_mts_ctx *c, cdl_xml_node *n, const char *name)
     return p;
 }
 
+/* The property's name as the file spells it (sunScale or sun_scale). */
+static const char *spelled(const cdl_xml_node *p, const char *name)
+{
+    const char *s = p ? cdl_xml_attr_get(p, "name") : NULL;
+    return s ? s : name;
+}
+
 static int ranged(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, double def, double lo, double hi,
                   double *out)
 {
     int rc = cdl_mts_float(c, n, name, def, out);
     if (!rc && !(*out >= lo && *out <= hi)) {
         cdl_xml_node *p = peek(c, n, name);
-        rc = cdl_mts_error(c, p ? p->line : n->line, "%s %g must be in [%g, %g]", name, *out, lo, hi);
+        rc = cdl_mts_error(c, p ? p->line : n->line, "%s %g must be in [%g, %g]", spelled(p, name), *out, lo, hi);
     }
     return rc;
 }
@@ -55,7 +62,7 @@ static int ranged_int(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, long de
     int rc = cdl_mts_int(c, n, name, def, out);
     if (!rc && !(*out >= lo && *out <= hi)) {
         cdl_xml_node *p = peek(c, n, name);
-        rc = cdl_mts_error(c, p ? p->line : n->line, "%s %ld must be in [%ld, %ld]", name, *out, lo, hi);
+        rc = cdl_mts_error(c, p ? p->line : n->line, "%s %ld must be in [%ld, %ld]", spelled(p, name), *out, lo, hi);
     }
     return rc;
 }
