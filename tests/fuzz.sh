@@ -34,7 +34,10 @@ seed() { # seed TARGET DIR
       cp "$src"/tests/bad_pbrt/*.pbrt "$d"/ 2>/dev/null
       find "$src/scenes" "$src/tests/data" -name '*.pbrt' -size -64k -exec cp {} "$d"/ \; 2>/dev/null ;;
     mitsuba)
-      cp "$src"/tests/bad_mitsuba/*.xml "$d"/ 2>/dev/null ;;
+      cp "$src"/tests/bad_mitsuba/*.xml "$d"/ 2>/dev/null
+      # Mitsuba 3's render-test scenes: every plugin the reader knows
+      find "$src/../shared/scenes/mitsuba3-tests" "$src/../shared/scenes/veach-mis" -name '*.xml' -size -64k \
+        -exec cp {} "$d"/ \; 2>/dev/null ;;
     ply)
       cp "$src"/tests/bad_ply/*.ply "$d"/ 2>/dev/null
       find "$src/tests/data" "$src/../shared/scenes/veach-bidir" -name '*.ply' -size -64k -exec cp {} "$d"/ \; 2>/dev/null ;;

@@ -22,7 +22,10 @@ fail=0
 ratio() { "$candela" diff "$1" "$2" | tr -s ' ' '\n' | awk 'p {print; exit} $0 == "mean_ratio" {p = 1}'; }
 within() { awk -v r="$1" -v t="$2" 'BEGIN {exit !(r >= 1 - t && r <= 1 + t)}'; }
 
-sed 's/"specular_reflectance" value="0.3, 0.3, 0.3"/"specular_reflectance" value="1, 1, 1"/' \
+# the reference is pbrt-v3's, whose plates are GGX: the Mitsuba file's
+# beckmann (rendered as such since issue 27) is made ggx to match
+sed -e 's/"specular_reflectance" value="0.3, 0.3, 0.3"/"specular_reflectance" value="1, 1, 1"/' \
+  -e 's/"distribution" value="beckmann"/"distribution" value="ggx"/' \
   "$scenes/veach-mis/mitsuba3/scene.xml" > "$tmp/veach-mis.xml"
 ROBUST=1 bash "$here/reference.sh" "$candela" "$shared/references/veach-mis_bdpt_320x180.exr" 16 0.01 -- \
   "$tmp/veach-mis.xml" -i bdpt --maxdepth 3 --res 320x180 || fail=1

@@ -2,7 +2,7 @@
  * microfacet ones are tested by test_microfacet.c.
  *
  * Opaque materials (Lambert, Phong at several exponents, Phong without a
- * diffuse part), for several outgoing directions on both sides of the
+ * diffuse part, Oren-Nayar's qualitative and full models), for several outgoing directions on both sides of the
  * geometric normal, with the shading normal equal to the geometric normal
  * and tilted from it:
  *  - chi-square goodness of fit of cdl_bsdf_sample against cdl_bsdf_pdf,
@@ -38,7 +38,7 @@
 
 /* Chi-square tests in this program, for the Sidak correction of P_MIN
  * (test_stats.h). */
-#define N_CHI2 132
+#define N_CHI2 156
 
 /* ---- opaque materials ---------------------------------------------------- */
 
@@ -49,6 +49,7 @@ typedef struct opaque_case {
     const char *name;
     cdl_mat_type type;
     float kd, ks, ns;
+    float sigma; /* rough diffuse; ks > 0 selects the full model */
 } opaque_case;
 
 static cdl_material make_material(cdl_mat_type type, float kd, float ks, float ns, float eta)
@@ -68,6 +69,24 @@ static cdl_material make_material(cdl_mat_type type, float kd, float ks, float n
 }
 
 
+/* Oren-Nayar at normal incidence and exit: rho / pi (A + rho C4) for the
+ * full model (Mitsuba 0.6), rho A / pi for the qualitative one (pbrt). */
+static void test_oren_nayar_normal(void)
+{
+    float s = 0.5f, s2 = s * s, a = 1.0f - 0.5f * s2 / (s2 + 0.33f), c4 = 0.17f * s2 / (s2 + 0.13f), rho = 0.8f;
+    for (int full = 0; full < 2; full++) {
+        cdl_material m = make_material(CDL_MAT_ROUGH_DIFFUSE, rho, 0.0f, 0.0f, 1.0f);
+        m.sigma = s;
+        m.on_full = full;
+        cdl_bsdf b;
+        cdl_vec3 n = cdl_v3(0.0f, 0.0f, 1.0f);
+        cdl_bsdf_init(&b, &m, m.kd, n, n);
+        float f = cdl_bsdf_eval(&b, n, n, 0).x, want = rho * CDL_INV_PI * (a + (full ? rho * c4 : 0.0f));
+        check(fabsf(f - want) < 1e-5f, "oren-nayar %s at normal incidence: f = %.6f (%.6f)",
+              full ? "full" : "qualitative", (double)f, (double)want);
+    }
+}
+
 static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64_t stream)
 {
     dvec ngd = geo_normal();
@@ -75,6 +94,10 @@ static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64
     dvec nsd = tilted ? polar(&gf, 10.0 * DEG, 40.0 * DEG) : ngd;
     dvec wod = polar(&gf, wo_deg * DEG, 0.0);
     cdl_material m = make_material(mc->type, mc->kd, mc->ks, mc->ns, 1.0f);
+    m.sigma = mc->sigma;
+    m.on_full = mc->ks > 0.0f;
+    if (mc->type == CDL_MAT_ROUGH_DIFFUSE)
+        m.ks = cdl_v3(0.0f, 0.0f, 0.0f);
     cdl_bsdf b;
     cdl_bsdf_init(&b, &m, m.kd, to_f(nsd), to_f(ngd));
     cdl_vec3 wo = to_f(wod);
@@ -254,6 +277,10 @@ static void test_opaque(const opaque_case *mc, double wo_deg, int tilted, uint64
     if (is_phong)
         wb = (mc->kd + mc->ks) * (mc->kd + mc->ks * (n + 2.0) / 2.0) /
              (mc->kd + mc->ks * (n + 1.0) / 2.0);
+    /* Oren-Nayar's weight pi f (cosine-sampled) grows without bound towards
+     * grazing back-scattering (its tan beta); the albedo below is bounded */
+    if (mc->type == CDL_MAT_ROUGH_DIFFUSE)
+        wb = INFINITY;
     double wlimit = fmax(1.0, wb) + 1e-4;
     check(max_w <= wlimit, "%s: max sample weight %.5f (<= %.4f%s)", tag, max_w, wlimit,
           wb > 1.0 ? ": this sampler's supremum for this material exceeds 1" : "");
@@ -540,12 +567,14 @@ int main(void)
     test_init();
 
     static const opaque_case cases[] = {
-        {"lambert kd=0.8", CDL_MAT_DIFFUSE, 0.8f, 0.0f, 0.0f},
-        {"phong kd=0.3 ks=0.6 n=1", CDL_MAT_PHONG, 0.3f, 0.6f, 1.0f},
-        {"phong kd=0.3 ks=0.6 n=10", CDL_MAT_PHONG, 0.3f, 0.6f, 10.0f},
-        {"phong kd=0.3 ks=0.6 n=100", CDL_MAT_PHONG, 0.3f, 0.6f, 100.0f},
-        {"phong kd=0.3 ks=0.6 n=1000", CDL_MAT_PHONG, 0.3f, 0.6f, 1000.0f},
-        {"phong kd=0 ks=0.9 n=30", CDL_MAT_PHONG, 0.0f, 0.9f, 30.0f},
+        {"lambert kd=0.8", CDL_MAT_DIFFUSE, 0.8f, 0.0f, 0.0f, 0.0f},
+        {"phong kd=0.3 ks=0.6 n=1", CDL_MAT_PHONG, 0.3f, 0.6f, 1.0f, 0.0f},
+        {"phong kd=0.3 ks=0.6 n=10", CDL_MAT_PHONG, 0.3f, 0.6f, 10.0f, 0.0f},
+        {"phong kd=0.3 ks=0.6 n=100", CDL_MAT_PHONG, 0.3f, 0.6f, 100.0f, 0.0f},
+        {"phong kd=0.3 ks=0.6 n=1000", CDL_MAT_PHONG, 0.3f, 0.6f, 1000.0f, 0.0f},
+        {"phong kd=0 ks=0.9 n=30", CDL_MAT_PHONG, 0.0f, 0.9f, 30.0f, 0.0f},
+        {"oren-nayar qualitative kd=1 sigma=0.6", CDL_MAT_ROUGH_DIFFUSE, 1.0f, 0.0f, 0.0f, 0.6f},
+        {"oren-nayar full kd=1 sigma=0.6", CDL_MAT_ROUGH_DIFFUSE, 1.0f, 1.0f, 0.0f, 0.6f},
     };
     /* Angles from ng: > 90 is on the back side (135 = 45deg, 95 = 85deg). */
     static const double wos[] = {0.0, 30.0, 60.0, 85.0, 135.0, 95.0};
@@ -563,6 +592,7 @@ int main(void)
     test_mirror(85.0, 1, 180.0); /* reflection about ns dips below the surface */
 
     test_fresnel();
+    test_oren_nayar_normal();
     static const double ent[] = {0.0, 30.0, 60.0, 85.0};
     static const double ext[] = {0.0, 30.0, 40.0, 45.0, 60.0, 85.0};
     for (size_t i = 0; i < sizeof ent / sizeof ent[0]; i++)

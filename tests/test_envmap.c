@@ -1,6 +1,9 @@
 /* Environment maps against closed forms:
- *  - the map's sampling: the returned pdf equals cdl_envmap_pdf, the pdf
- *    integrates to 1 over the sphere, and E[L / pdf] is the map's flux;
+ *  - the map's sampling (each layout): the returned pdf equals
+ *    cdl_envmap_pdf, the pdf integrates to 1 over the sphere, and
+ *    E[L / pdf] is the map's flux;
+ *  - Mitsuba's layout interpolates bilinearly between texels at
+ *    u = (x + 1/2) / w, v = y / (h - 1), across the seam at u = 0 too;
  *  - a rotated frame turns the map with it;
  *  - rendered by an integrator (argument, default path): a Lambertian plane
  *    of albedo rho under two hemispheres of radiance L1 (light +z) and L2
@@ -53,22 +56,29 @@ static uint32_t passes(const char *integ, cdl_options *opt, uint32_t spp)
 }
 
 /* Two hemispheres in the light frame: rows above the equator L1, below L2,
- * with a bright spot so that importance sampling has something to find. */
-static cdl_envmap *two_hemispheres(float L1, float L2, int spot, const cdl_vec3 frame[3])
+ * with a bright spot so that importance sampling has something to find.
+ * In Mitsuba's layout the rows are nodes from pole to pole: 33 of them put
+ * row 16 on the equator, and the upper hemisphere (rows 0 to 16) is all L1. */
+static cdl_envmap *two_hemispheres_in(int layout, float L1, float L2, int spot, const cdl_vec3 frame[3])
 {
-    int w = 64, h = 32;
+    int w = 64, h = layout == CDL_ENVMAP_MITSUBA ? 33 : 32, upper = layout == CDL_ENVMAP_MITSUBA ? 17 : 16;
     float *rgb = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++)
             for (int c = 0; c < 3; c++)
-                rgb[3 * (y * w + x) + c] = y < h / 2 ? L1 : L2;
+                rgb[3 * (y * w + x) + c] = y < upper ? L1 : L2;
     if (spot)
         for (int c = 0; c < 3; c++)
             rgb[3 * (5 * w + 9) + c] = 400.0f;
     cdl_envmap *m = malloc(sizeof *m);
     cdl_error err;
-    die_on(cdl_envmap_init(m, w, h, rgb, frame, 0, &err), &err);
+    die_on(cdl_envmap_init(m, w, h, rgb, frame, layout, &err), &err);
     return m;
+}
+
+static cdl_envmap *two_hemispheres(float L1, float L2, int spot, const cdl_vec3 frame[3])
+{
+    return two_hemispheres_in(CDL_ENVMAP_EQUIRECT, L1, L2, spot, frame);
 }
 
 static const cdl_vec3 zup[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
@@ -119,14 +129,36 @@ static void equal_area_mapping(void)
           ez, ez2);
 }
 
-static void sampling(int equal_area)
+/* The integral of the map's radiance (red) over the sphere by the midpoint
+ * rule on a fine (theta, phi) grid. */
+static double flux_by_quadrature(const cdl_envmap *m)
 {
-    cdl_envmap *m = equal_area ? equal_area_map(1.0f, 0.25f, 1) : two_hemispheres(1.0f, 0.25f, 1, zup);
-    const char *kind = equal_area ? "equal-area" : "equirectangular";
+    enum { NT = 2048, NP = 4096 };
+    double sum = 0.0;
+    for (int i = 0; i < NT; i++) {
+        double th = CDL_PI * (i + 0.5) / NT, row = 0.0;
+        for (int j = 0; j < NP; j++) {
+            double ph = 2.0 * CDL_PI * (j + 0.5) / NP;
+            cdl_vec3 d = cdl_v3((float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th));
+            row += cdl_envmap_eval(m, d).x;
+        }
+        sum += row * sin(th);
+    }
+    return sum * (CDL_PI / NT) * (2.0 * CDL_PI / NP);
+}
+
+static void sampling(int layout)
+{
+    cdl_envmap *m = layout == CDL_ENVMAP_EQUAL_AREA ? equal_area_map(1.0f, 0.25f, 1)
+                                                    : two_hemispheres_in(layout, 1.0f, 0.25f, 1, zup);
+    const char *kind = layout == CDL_ENVMAP_EQUAL_AREA ? "equal-area"
+                       : layout == CDL_ENVMAP_MITSUBA  ? "Mitsuba's bilinear"
+                                                       : "equirectangular";
     cdl_rng rng;
     cdl_rng_seed(&rng, 7, 0);
     enum { N = 400000 };
     double est = 0.0, pdf_int = 0.0, worst = 0.0;
+    int uncovered = 0;
     for (int i = 0; i < N; i++) {
         cdl_vec3 w;
         float pdf;
@@ -136,19 +168,30 @@ static void sampling(int equal_area)
             worst = fmax(worst, fabs(cdl_envmap_pdf(m, w) / pdf - 1.0));
         }
         cdl_vec3 d = cdl_sample_uniform_sphere(cdl_rng_float(&rng), cdl_rng_float(&rng));
-        pdf_int += cdl_envmap_pdf(m, d) * 4.0 * CDL_PI;
+        float p = cdl_envmap_pdf(m, d);
+        pdf_int += p * 4.0 * CDL_PI;
+        uncovered += !(p > 0.0f) && cdl_envmap_eval(m, d).x > 0.0f;
     }
     est /= N;
     pdf_int /= N;
     CHECK(worst < 1e-3, "%s: pdf of the sampled direction equals the sample's pdf (worst %.2g)", kind, worst);
     CHECK(fabs(pdf_int - 1.0) < 0.02, "%s: pdf integrates to %.4f over the sphere (1 within 2 %%)", kind, pdf_int);
+    CHECK(uncovered == 0, "%s: the pdf is positive wherever the radiance is (%d directions not)", kind, uncovered);
     CHECK(fabs(est / m->flux.x - 1.0) < 0.005, "%s: E[L/pdf] %.5f vs flux %.5f (within 0.5 %%)", kind, est,
           (double)m->flux.x);
-    if (equal_area) { /* every texel 4 pi / n^2 */
+    if (layout == CDL_ENVMAP_EQUAL_AREA) { /* every texel 4 pi / n^2 */
         double f = 0.0;
         for (int i = 0; i < m->w * m->h; i++)
             f += m->rgb[3 * i] * 4.0 * CDL_PI / (m->w * m->h);
         CHECK(fabs(m->flux.x / f - 1.0) < 1e-4, "equal-area: flux %.5f vs %.5f", (double)m->flux.x, f);
+        cdl_envmap_free(m);
+        free(m);
+        return;
+    }
+    if (layout == CDL_ENVMAP_MITSUBA) { /* the interpolated radiance's integral */
+        double f = flux_by_quadrature(m);
+        CHECK(fabs(m->flux.x / f - 1.0) < 1e-3, "Mitsuba's bilinear: flux %.5f vs %.5f by quadrature",
+              (double)m->flux.x, f);
         cdl_envmap_free(m);
         free(m);
         return;
@@ -166,6 +209,60 @@ static void sampling(int equal_area)
     CHECK(a.x == 1.0f && b.x == 0.25f, "envmap: rotated frame: up %g, down %g", (double)a.x, (double)b.x);
     cdl_envmap_free(m);
     free(m);
+}
+
+/* The direction of (u, v) in the z-up light frame. */
+static cdl_vec3 uv_dir(double u, double v)
+{
+    double ph = 2.0 * CDL_PI * u, th = CDL_PI * v;
+    return cdl_v3((float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th));
+}
+
+/* Mitsuba's layout: texel (x, y) is seen at u = (x + 1/2) / w,
+ * v = y / (h - 1), halfway between texels is their mean, across the seam at
+ * u = 0 too (the last column's neighbour is the first), and a constant map
+ * has the flux 4 pi L. */
+static void mitsuba_layout(void)
+{
+    int w = 6, h = 5;
+    float *rgb = malloc(sizeof(float) * 3 * (size_t)(w * h));
+    for (int i = 0; i < w * h; i++) /* the poles' rows constant: each is one direction */
+        for (int c = 0; c < 3; c++)
+            rgb[3 * i + c] = (i < w ? 3.0f : i >= w * (h - 1) ? 5.0f : (float)(1 + (i * 7) % 11)) + 0.5f * (float)c;
+    cdl_envmap m;
+    cdl_error err;
+    die_on(cdl_envmap_init(&m, w, h, rgb, zup, CDL_ENVMAP_MITSUBA, &err), &err);
+    int nodes = 0, mids = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *t = rgb + 3 * (y * w + x), *r = rgb + 3 * (y * w + (x + 1) % w);
+            cdl_vec3 L = cdl_envmap_eval(&m, uv_dir((x + 0.5) / w, (double)y / (h - 1)));
+            nodes += fabsf(L.x - t[0]) < 1e-4f && fabsf(L.z - t[2]) < 1e-4f;
+            if (y == 0 || y == h - 1) /* at a pole every u is the same direction */
+                continue;
+            /* halfway to the right neighbour (for x = w - 1 across u = 0) */
+            L = cdl_envmap_eval(&m, uv_dir((x + 1.0) / w, (double)y / (h - 1)));
+            mids += fabsf(L.x - 0.5f * (t[0] + r[0])) < 1e-4f;
+        }
+    CHECK(nodes == w * h, "Mitsuba's layout: %d of %d texels seen at their nodes", nodes, w * h);
+    CHECK(mids == w * (h - 2), "Mitsuba's layout: %d of %d midpoints (the seam's too) the mean of two texels", mids,
+          w * (h - 2));
+    /* halfway between rows 1 and 2 at texel 3's column */
+    cdl_vec3 L = cdl_envmap_eval(&m, uv_dir(3.5 / w, 1.5 / (h - 1)));
+    float want = 0.5f * (rgb[3 * (1 * w + 3)] + rgb[3 * (2 * w + 3)]);
+    CHECK(fabsf(L.x - want) < 1e-4f, "Mitsuba's layout: between rows %g, expected %g", (double)L.x, (double)want);
+    cdl_envmap_free(&m);
+    float *c = malloc(sizeof(float) * 3 * (size_t)(w * h));
+    for (int i = 0; i < 3 * w * h; i++)
+        c[i] = 2.0f;
+    die_on(cdl_envmap_init(&m, w, h, c, zup, CDL_ENVMAP_MITSUBA, &err), &err);
+    CHECK(fabs(m.flux.x / (8.0 * CDL_PI) - 1.0) < 1e-5, "Mitsuba's layout: a constant 2 has flux %.6f (8 pi)",
+          (double)m.flux.x);
+    cdl_envmap_free(&m);
+    float *small = malloc(sizeof(float) * 3 * 4);
+    CHECK(cdl_envmap_init(&m, 2, 2, small, zup, CDL_ENVMAP_MITSUBA, &err) != 0,
+          "Mitsuba's layout: a 2x2 map is refused (%s)", err.msg);
+    free(small);
 }
 
 /* Mean radiance of the film's pixels whose rays through the centre and the
@@ -220,7 +317,7 @@ static void render_view(const char *integ, cdl_scene *s, cdl_vec3 eye, cdl_vec3 
     render_film(method(integ), s, opt, 16, 16, passes(integ, opt, spp), f);
 }
 
-static void plane_under_map(const char *integ, int facing_boundary)
+static void plane_under_map(const char *integ, int facing_boundary, int layout)
 {
     cdl_scene s;
     cdl_error err;
@@ -230,7 +327,7 @@ static void plane_under_map(const char *integ, int facing_boundary)
      * in halves), or in z = 0 facing +z */
     static const float px[12] = {0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1};
     add_square(&s, facing_boundary ? px : square_z, rho);
-    die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), two_hemispheres(L1, L2, 0, zup), &err), &err);
+    die_on(cdl_scene_add_env_light(&s, cdl_v3(1, 1, 1), two_hemispheres_in(layout, L1, L2, 0, zup), &err), &err);
     cdl_options opt;
     cdl_film f;
     int W = 16, H = 16;
@@ -241,8 +338,9 @@ static void plane_under_map(const char *integ, int facing_boundary)
     double m = mean_where(&f, &s, &opt.camera, 1, &n);
     double expect = facing_boundary ? rho * (L1 + L2) / 2.0 : rho * L1;
     CHECK(n > W * H / 2 && fabs(m / expect - 1.0) < 0.01 * tol_scale,
-          "%s: plane facing %s under two hemispheres: %.4f, expected %.4f (within %.1f %%)", integ,
-          facing_boundary ? "the boundary" : "+z", m, expect, tol_scale);
+          "%s: plane facing %s under two hemispheres%s: %.4f, expected %.4f (within %.1f %%)", integ,
+          facing_boundary ? "the boundary" : "+z", layout == CDL_ENVMAP_MITSUBA ? " (Mitsuba's map)" : "", m, expect,
+          tol_scale);
     cdl_film_free(&f);
     cdl_scene_free(&s);
 }
@@ -357,12 +455,15 @@ int main(int argc, char **argv)
         spp_div = (uint32_t)atoi(getenv("CDL_TEST_SCALE"));
         tol_scale = sqrt((double)spp_div);
     }
-    sampling(0);
+    sampling(CDL_ENVMAP_EQUIRECT);
     equal_area_mapping();
-    sampling(1);
+    sampling(CDL_ENVMAP_EQUAL_AREA);
+    sampling(CDL_ENVMAP_MITSUBA);
+    mitsuba_layout();
     pbrt_map();
-    plane_under_map(integ, 1);
-    plane_under_map(integ, 0);
+    plane_under_map(integ, 1, CDL_ENVMAP_EQUIRECT);
+    plane_under_map(integ, 0, CDL_ENVMAP_EQUIRECT);
+    plane_under_map(integ, 0, CDL_ENVMAP_MITSUBA);
     plane_under_distant(integ);
     sphere_under_constant(integ, 0);
     sphere_under_constant(integ, 1);

@@ -20,6 +20,8 @@
 #include "core/transform.h"
 #include "film/image.h"
 #include "io/loader.h"
+#include "scene/microfacet_mts.h"
+#include "scene/plastic.h"
 #include "test_util.h"
 
 #define PI 3.14159265358979323846
@@ -132,6 +134,33 @@ static void camera_and_transforms(void)
     }
 }
 
+/* mask: a copy of the nested material with its opacity; plastic. */
+static void mask_and_plastic(void)
+{
+    write_file("mask.xml", "<scene version=\"3.0.0\">\n" LIGHT
+                           "<bsdf type=\"diffuse\" id=\"leaf\"><rgb name=\"reflectance\" value=\"0.1, 0.8, 0.1\"/></bsdf>\n"
+                           "<shape type=\"rectangle\"><bsdf type=\"mask\"><float name=\"opacity\" value=\"0.25\"/>"
+                           "<ref id=\"leaf\"/></bsdf></shape>\n"
+                           "<shape type=\"rectangle\"><bsdf type=\"plastic\"><float name=\"int_ior\" value=\"1.9\"/>"
+                           "<boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>\n"
+                           "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    if (load("mask.xml", &s, &set)) {
+        CHECK(0, "mask.xml loads");
+        return;
+    }
+    const cdl_material *m = s.mats;
+    CHECK(s.nmats == 3 && !m[0].masked && m[1].masked && m[1].opacity == 0.25f && m[1].opacity_tex < 0 &&
+              m[1].type == CDL_MAT_DIFFUSE && near3(m[1].kd, m[0].kd, 0.0f),
+          "mask over a referenced diffuse: a masked copy, opacity 0.25 (%u materials)", s.nmats);
+    CHECK(s.nmats == 3 && m[2].type == CDL_MAT_COATED && fabsf(m[2].eta - (float)(1.9 / 1.000277)) < 1e-5f &&
+              m[2].nonlinear && fabsf(m[2].spec_weight - 1.0f / 1.5f) < 1e-6f &&
+              fabsf(m[2].coat_ri - cdl_fresnel_diffuse_reflectance(1.0f / m[2].eta)) < 1e-6f,
+          "plastic: smooth coat, int_ior 1.9, nonlinear, default kd 0.5 (weight 1 / 1.5), Fdr from inside");
+    cdl_scene_free(&s);
+}
+
 /* Mitsuba 0.6 spelling (toWorld, intIOR, specularReflectance), include,
  * refs, the default bsdf, materials and emitters. */
 static void materials_and_include(void)
@@ -171,9 +200,13 @@ static void materials_and_include(void)
           "included roughconductor Au, alpha 0.2, specularReflectance 0.3");
     CHECK(m[1].type == CDL_MAT_DIELECTRIC && fabsf(m[1].eta - 1.6f) < 1e-6f, "dielectric intIOR/extIOR = %g",
           (double)m[1].eta);
-    CHECK(m[2].type == CDL_MAT_PLASTIC && fabsf(m[2].eta - (float)(1.333 / 1.000277)) < 1e-4f &&
-              near3(m[2].kd, cdl_v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m[2].alpha_x - 0.1f) < 1e-6f,
-          "twosided roughplastic: water / air = %g, kd, alpha 0.1", (double)m[2].eta);
+    CHECK(m[2].type == CDL_MAT_ROUGH_COATED && fabsf(m[2].eta - (float)(1.333 / 1.000277)) < 1e-4f &&
+              near3(m[2].kd, cdl_v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m[2].alpha_x - 0.1f) < 1e-6f &&
+              m[2].mf == CDL_MF_BECKMANN && fabsf(m[2].spec_weight - 1.0f / 1.2f) < 1e-6f && m[2].coat_ri > 0.3f &&
+              m[2].coat_ri < 0.6f && m[2].coat_t[CDL_COAT_RES - 1] > 0.9f && !m[2].nonlinear,
+          "twosided roughplastic: Mitsuba's coated model, water / air = %g, kd, beckmann alpha 0.1, specular "
+          "sampling weight %g (1 / 1.2), inside reflectance %g, transmittance at normal incidence %g",
+          (double)m[2].eta, (double)m[2].spec_weight, (double)m[2].coat_ri, (double)m[2].coat_t[CDL_COAT_RES - 1]);
     CHECK(m[3].type == CDL_MAT_DIFFUSE && near3(m[3].kd, cdl_v3(0.5f, 0.5f, 0.5f), 0.0f),
           "a shape without bsdf gets diffuse 0.5");
     CHECK(s.nspheres == 1 && near3(cdl_v3(s.sph[0], s.sph[1], s.sph[2]), cdl_v3(2, 4, 6), 1e-5f) &&
@@ -367,7 +400,9 @@ static void search_paths(void)
 
 /* Each texel of an 8 x 4 map is seen in Mitsuba's direction for it:
  * local d = (sin phi sin theta, cos theta, -cos phi sin theta) with
- * phi = 2 pi u, theta = pi v, turned by to_world. */
+ * phi = 2 pi u, theta = pi v, turned by to_world, where Mitsuba puts the
+ * texel's node: u = (x + 1/2) / 8, v = y / 3 (the rows from pole to pole);
+ * halfway between two nodes of a row is their mean. */
 static void envmap_orientation(void)
 {
     cdl_image img;
@@ -392,15 +427,23 @@ static void envmap_orientation(void)
     }
     cdl_mat4 rot;
     cdl_mat4_rotate(90.0, 1, 0, 0, &rot);
-    int good = 0;
-    for (int y = 0; y < 4; y++)
-        for (int x = 0; x < 8; x++) {
-            double phi = 2.0 * PI * (x + 0.5) / 8.0, th = PI * (y + 0.5) / 4.0;
-            cdl_vec3 d = cdl_v3((float)(sin(phi) * sin(th)), (float)cos(th), (float)(-cos(phi) * sin(th)));
-            cdl_vec3 L = cdl_envmap_eval(s.envmap, cdl_mat4_vector3(&rot, d));
-            good += fabsf(L.x - 2.0f * (float)(y * 8 + x + 1)) < 1e-4f;
-        }
-    CHECK(good == 32, "envmap: %d of 32 texels seen in Mitsuba's direction (turned by to_world), scaled by 2", good);
+    int good = 0, mid = 0;
+    for (int y = 1; y < 3; y++) /* rows 0 and 3 are the poles: one direction each */
+        for (int x = 0; x < 8; x++)
+            for (int half = 0; half < 2; half++) {
+                double phi = 2.0 * PI * (x + 0.5 + 0.5 * half) / 8.0, th = PI * y / 3.0;
+                cdl_vec3 d = cdl_v3((float)(sin(phi) * sin(th)), (float)cos(th), (float)(-cos(phi) * sin(th)));
+                cdl_vec3 L = cdl_envmap_eval(s.envmap, cdl_mat4_vector3(&rot, d));
+                float want = 2.0f * (float)(y * 8 + x + 1) + (half ? (x == 7 ? -7.0f : 1.0f) : 0.0f);
+                if (half)
+                    mid += fabsf(L.x - want) < 1e-3f;
+                else
+                    good += fabsf(L.x - want) < 1e-3f;
+            }
+    CHECK(good == 16 && mid == 16 && s.envmap->layout == CDL_ENVMAP_MITSUBA,
+          "envmap: %d of 16 texels seen in Mitsuba's direction (turned by to_world), scaled by 2, and %d of 16 "
+          "midpoints the mean of their two texels",
+          good, mid);
     cdl_scene_free(&s);
 }
 
@@ -543,6 +586,7 @@ int main(int argc, char **argv)
     }
     camera_and_transforms();
     materials_and_include();
+    mask_and_plastic();
     obj_uvs();
     search_paths();
     spectra();

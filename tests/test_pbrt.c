@@ -430,6 +430,24 @@ static void test_materials(void)
           "v4 diffuse reflectance (%g %g %g)", V3(m[9]->kd));
     cdl_scene_free(&s);
 
+    /* sampled spectra through the CIE observer: a constant reflectance is
+     * grey, one above 600 nm is red; a light's L as emitted */
+    snprintf(text, sizeof text,
+             "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"spectrum L\" [400 0 600 0 610 1 700 1]\n"
+             "Material \"matte\" \"spectrum Kd\" [400 0.5 700 0.5]\n%sAttributeEnd\n"
+             "Material \"matte\" \"spectrum Kd\" [400 0 600 0 610 0.8 700 0.8]\nTranslate 0 0 1\n%s",
+             TRI, TRI);
+    write_file("sampled.pbrt", text);
+    if (!load("sampled.pbrt", &s, &set, &err)) {
+        cdl_vec3 grey = s.mats[s.tri_mat[0]].kd, red = s.mats[s.tri_mat[1]].kd;
+        CHECK(near3(grey, cdl_v3(0.5f, 0.5f, 0.5f), 2e-3f) && red.x > 0.3f && red.x > 5.0f * red.y &&
+                  red.x > 5.0f * red.z && s.nlights == 1,
+              "sampled Kd: constant 0.5 -> (%g %g %g), above 600 nm -> (%g %g %g)", V3(grey), V3(red));
+        cdl_scene_free(&s);
+    } else {
+        CHECK(0, "sampled.pbrt loads");
+    }
+
     /* a spot whose conedelta (default 5) exceeds its coneangle: pbrt renders
      * it, the falloff clamped to start at the axis; a warning names the line */
     snprintf(text, sizeof text,

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "scene/envmap.h"
 #include "scene/sunsky.h"
 #include "test_util.h"
 
@@ -198,12 +199,42 @@ static void test_power(void)
     }
 }
 
+/* The reader's image (rows at Mitsuba 3's envmap nodes) as candela's
+ * environment map in that layout: the same power as the texel-centred one. */
+static void test_node_rows(void)
+{
+    cdl_error err = {0};
+    cdl_sunsky_params p;
+    cdl_sunsky_params_init(&p);
+    p.sun_zenith = 40.0 * PI / 180.0;
+    p.sun_azimuth = 1.0;
+    double ref[3];
+    float *rgb;
+    die_on(cdl_sunsky_image(&p, &rgb, &err), &err);
+    image_power(rgb, p.width, p.height, ref);
+    free(rgb);
+    p.node_rows = 1;
+    die_on(cdl_sunsky_image(&p, &rgb, &err), &err);
+    const cdl_vec3 frame[3] = {cdl_v3(0, 0, -1), cdl_v3(1, 0, 0), cdl_v3(0, 1, 0)};
+    cdl_envmap m;
+    die_on(cdl_envmap_init(&m, p.width, p.height, rgb, frame, CDL_ENVMAP_MITSUBA, &err), &err);
+    double worst = fmax(fabs(m.flux.x / ref[0] - 1.0), fmax(fabs(m.flux.y / ref[1] - 1.0), fabs(m.flux.z / ref[2] - 1.0)));
+    CHECK(worst < 0.01, "Mitsuba's envmap layout: flux (%.5g, %.5g, %.5g), the texel-centred image's (%.5g, %.5g, %.5g)",
+          (double)m.flux.x, (double)m.flux.y, (double)m.flux.z, ref[0], ref[1], ref[2]);
+    /* the sun where the image says, looked up through the map */
+    cdl_vec3 s = cdl_sunsky_sun_dir(&p);
+    cdl_vec3 at = cdl_envmap_eval(&m, s), away = cdl_envmap_eval(&m, cdl_v3(-s.x, s.y, -s.z));
+    CHECK(at.y > 100.0f * away.y, "the sun through the map: %g, the sky opposite it %g", (double)at.y, (double)away.y);
+    cdl_envmap_free(&m);
+}
+
 int main(void)
 {
     test_psa();
     test_sky();
     test_sun_disk();
     test_power();
+    test_node_rows();
     printf("%s\n", test_failures ? "FAILED" : "all passed");
     return test_failures != 0;
 }

@@ -1,7 +1,8 @@
 /* Mitsuba bsdfs, textures and emitters as candela's materials and lights.
  * Defaults are Mitsuba 3's; what candela has no model for is approximated
- * with a warning (roughness distributions are all GGX, plastic is pbrt's
- * plastic, wavelength spectra are greys). */
+ * with a warning. Plastic and roughplastic are Mitsuba's own coated model
+ * (scene/plastic.h); they and the rough conductors and dielectrics use
+ * Mitsuba's microfacet model (scene/microfacet_mts.h). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -10,6 +11,8 @@
 
 #include "io/mitsuba_internal.h"
 #include "io/pbrt_params.h"
+#include "scene/microfacet_mts.h"
+#include "scene/plastic.h"
 #include "scene/scene.h"
 
 /* Mitsuba's named indices of refraction (its ior.h table). */
@@ -154,9 +157,14 @@ static int roughness(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
         return cdl_mts_error(c, n->line, "alpha (%g, %g) must be in [0, 10]", au, av);
     if (rough && strcmp(dist, "ggx") && strcmp(dist, "beckmann") && strcmp(dist, "phong"))
         return cdl_mts_error(c, n->line, "distribution \"%s\" must be ggx, beckmann or phong", dist);
+    /* sampling only: candela always samples the visible normals, which
+     * changes the noise, not the image */
     cdl_mts_prop(c, n, "sample_visible");
     m->alpha_x = (float)au;
     m->alpha_y = (float)av;
+    m->mf = strcmp(dist, "ggx") ? CDL_MF_BECKMANN : CDL_MF_GGX;
+    if (rough && !strcmp(dist, "phong"))
+        cdl_mts_warn(c, n->line, "distribution \"phong\" (Mitsuba 0.6) read as beckmann");
     return 0;
 }
 
@@ -244,6 +252,87 @@ static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
         (rc = roughness(c, n, rough, m)))
         return rc;
     m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
+    if (!rough)
+        m->mf = CDL_MF_PBRT; /* a mirror (alpha 0) */
+    return 0;
+}
+
+/* Mitsuba's Texture::mean(): the channels' mean of a constant, the mean
+ * luminance of a bitmap (times candela's constant factor). */
+static float texture_mean(cdl_mts_ctx *c, cdl_vec3 v, int tex)
+{
+    float k = (v.x + v.y + v.z) / 3.0f;
+    if (tex < 0 || tex >= (int)c->s->ntexs)
+        return k;
+    const cdl_texture *t = &c->s->texs[tex];
+    double sum = 0.0;
+    size_t np = (size_t)t->w * (size_t)t->h;
+    for (size_t i = 0; i < np; i++)
+        sum += cdl_luminance(cdl_v3(t->rgb[3 * i], t->rgb[3 * i + 1], t->rgb[3 * i + 2]));
+    return np ? k * (float)(sum / (double)np) : k;
+}
+
+static int plastic(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m)
+{
+    *m = cdl_material_default(rough ? CDL_MAT_ROUGH_COATED : CDL_MAT_COATED);
+    cdl_xml_node *ksn = cdl_mts_prop(c, n, "specular_reflectance");
+    int rc, ks_given = ksn != NULL;
+    if (ksn)
+        ksn->used = 0; /* read below */
+    if ((rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)) ||
+        (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
+        (rc = rel_ior(c, n, 1.49, &m->eta)) || (rc = roughness(c, n, rough, m)) ||
+        (rc = cdl_mts_bool(c, n, "nonlinear", 0, &m->nonlinear)))
+        return rc;
+    m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
+    m->kd = at_most_one(c, n->line, "diffuse reflectance", m->kd);
+    if (fabsf(m->eta - 1.0f) < 1e-6f)
+        return cdl_mts_error(c, n->line, "bsdf \"%s\": int_ior and ext_ior must differ", rough ? "roughplastic" : "plastic");
+    if (rough && m->alpha_x != m->alpha_y)
+        return cdl_mts_error(c, n->line, "bsdf \"roughplastic\": anisotropic roughness is not supported (nor by Mitsuba)");
+    float d = texture_mean(c, m->kd, m->kd_tex), sm = ks_given ? (m->ks.x + m->ks.y + m->ks.z) / 3.0f : 1.0f;
+    m->spec_weight = d + sm > 0.0f ? sm / (d + sm) : 0.5f;
+    cdl_coat_prepare(m);
+    return 0;
+}
+
+/* mask: the nested material (a copy) with an opacity, a constant or the
+ * luminance of a texture. */
+static int mask(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    cdl_vec3 v;
+    int tex, rc, found;
+    int32_t inner;
+    if ((rc = color(c, n, "opacity", cdl_v3(0.5f, 0.5f, 0.5f), &v, &tex)) ||
+        (rc = cdl_mts_child_bsdf(c, n, 0, &inner, &found)))
+        return rc;
+    if (!found)
+        return cdl_mts_error(c, n->line, "bsdf \"mask\" needs a nested <bsdf> or <ref>");
+    if (inner < 0) { /* a null bsdf stays invisible */
+        *mat = inner;
+        return 0;
+    }
+    cdl_material m = c->s->mats[inner];
+    float op = cdl_luminance(v);
+    if (m.masked && m.opacity_tex >= 0 && tex >= 0) {
+        cdl_mts_warn(c, n->line, "bsdf \"mask\" inside a textured mask: the inner texture is used, this one's scale only");
+        tex = m.opacity_tex;
+    }
+    if (m.masked) {
+        op *= m.opacity;
+        if (tex < 0)
+            tex = m.opacity_tex;
+    }
+    m.masked = 1;
+    m.opacity = cdl_minf(1.0f, op);
+    m.opacity_tex = tex;
+    const char *id = cdl_xml_attr_get(n, "id");
+    snprintf(m.name, sizeof m.name, "%.63s", id ? id : "mask");
+    cdl_mts_warn_unused(c, n, "mask");
+    uint32_t idx;
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+        return rc;
+    *mat = (int32_t)idx;
     return 0;
 }
 
@@ -255,7 +344,9 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         return rc;
     n->used = 1;
     /* wrappers: the surface is the nested bsdf's */
-    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "mask", "blendbsdf", "coating",
+    if (!strcmp(type, "mask"))
+        return mask(c, n, mat);
+    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "blendbsdf", "coating",
                                        "roughcoating"};
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
         if (!strcmp(type, wrap[i])) {
@@ -277,18 +368,23 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         m = cdl_material_default(CDL_MAT_DIFFUSE);
         rc = color(c, n, "reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
         if (!rc && type[0] == 'r') {
-            cdl_mts_warn(c, n->line, "bsdf \"roughdiffuse\": Oren-Nayar approximated by Lambert");
-            cdl_mts_prop(c, n, "alpha");
-            cdl_mts_prop(c, n, "use_fast_approx");
+            /* Mitsuba 0.6: sigma = alpha / sqrt(2), the full model unless
+             * use_fast_approx */
+            double alpha;
+            int fast;
+            if (!cdl_mts_prop(c, n, "reflectance") && cdl_mts_prop(c, n, "diffuse_reflectance"))
+                rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
+            if (!rc && !(rc = cdl_mts_float(c, n, "alpha", 0.2, &alpha)) &&
+                !(rc = cdl_mts_bool(c, n, "use_fast_approx", 0, &fast))) {
+                if (!(alpha >= 0.0 && alpha <= 10.0))
+                    return cdl_mts_error(c, n->line, "roughdiffuse alpha %g must be in [0, 10]", alpha);
+                m.type = CDL_MAT_ROUGH_DIFFUSE;
+                m.sigma = (float)(alpha / sqrt(2.0));
+                m.on_full = !fast;
+            }
         }
     } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
-        m = cdl_material_default(CDL_MAT_PLASTIC);
-        int nonlinear;
-        if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
-            !(rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
-            !(rc = rel_ior(c, n, 1.49, &m.eta)) && !(rc = roughness(c, n, rough, &m)))
-            rc = cdl_mts_bool(c, n, "nonlinear", 0, &nonlinear);
-        m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
+        rc = plastic(c, n, rough, &m);
     } else if (!strcmp(type, "conductor") || !strcmp(type, "roughconductor")) {
         rc = conductor(c, n, rough, &m);
     } else if (!strcmp(type, "dielectric") || !strcmp(type, "roughdielectric") || !strcmp(type, "thindielectric")) {
@@ -301,6 +397,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             rc = roughness(c, n, rough, &m);
         m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
         m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
+        if (!rough)
+            m.mf = CDL_MF_PBRT;
     } else if (!strcmp(type, "phong")) {
         double e = 30.0;
         m = cdl_material_default(CDL_MAT_PHONG);
@@ -338,7 +436,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     }
     if (rc)
         return rc;
-    if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_PLASTIC || m.type == CDL_MAT_PHONG)
+    if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_COATED || m.type == CDL_MAT_ROUGH_COATED ||
+        m.type == CDL_MAT_PHONG)
         m.kd = at_most_one(c, n->line, "diffuse reflectance", m.kd);
     const char *id = cdl_xml_attr_get(n, "id");
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : type);
@@ -429,7 +528,7 @@ int cdl_mts_latlong_light(cdl_mts_ctx *c, int line, const cdl_vec3 axes[3], cons
      * frame with x' = -z, y' = x, z' = y */
     cdl_vec3 frame[3] = {cdl_scale(axes[2], -1.0f), axes[0], axes[1]};
     /* the texel layout of Mitsuba's lat-long maps, one place for envmap and sunsky */
-    const int layout = 0;
+    const int layout = CDL_ENVMAP_MITSUBA;
     cdl_envmap *em = malloc(sizeof *em);
     if (!em) {
         free(rgb);

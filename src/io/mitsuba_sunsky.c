@@ -238,6 +238,7 @@ int cdl_mts_sunsky(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, const cdl_
         p.extend = is_sky && ext;
     }
     p.stretch = stretch;
+    p.node_rows = 1; /* cdl_mts_latlong_light's layout: Mitsuba 3's envmap nodes */
     p.width = res;
     p.height = res / 2;
     if ((rc = sun_position(c, n, &to_local, m3, &p.sun_zenith, &p.sun_azimuth)))

@@ -110,7 +110,8 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         cdl_envmap *em = malloc(sizeof *em);
         if (!em)
             return cdl_pbrt_error(c, c->line, "out of memory");
-        if ((rc = cdl_envmap_load(em, path, v, frame, equal_area, err))) {
+        int layout = equal_area ? CDL_ENVMAP_EQUAL_AREA : CDL_ENVMAP_EQUIRECT;
+        if ((rc = cdl_envmap_load(em, path, v, frame, layout, err))) {
             free(em);
             return rc;
         }

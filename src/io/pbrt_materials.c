@@ -177,8 +177,12 @@ static int make(cdl_pbrt_ctx *c, const char *type, cdl_material *m)
         if ((rc = mat_spectrum(c, type[0] == 'm' ? "Kd" : "reflectance", half, &m->kd, &m->kd_tex, NULL)) ||
             (rc = mat_float(c, "sigma", 0.0, &sigma)))
             return rc;
-        if (sigma > 0.0)
-            cdl_pbrt_warn(c, c->line, "matte sigma %g: Oren-Nayar approximated by Lambert", sigma);
+        if (!(sigma >= 0.0 && sigma <= 90.0))
+            return cdl_pbrt_error(c, c->line, "matte sigma %g must be in [0, 90] degrees", sigma);
+        if (sigma > 0.0) { /* pbrt's OrenNayar: the qualitative model */
+            m->type = CDL_MAT_ROUGH_DIFFUSE;
+            m->sigma = (float)(sigma * 3.14159265358979323846 / 180.0);
+        }
     } else if (!strcmp(type, "plastic")) {
         *m = cdl_material_default(CDL_MAT_PLASTIC);
         if ((rc = mat_spectrum(c, "Kd", quarter, &m->kd, &m->kd_tex, NULL)) ||

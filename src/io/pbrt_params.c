@@ -1,5 +1,7 @@
 #include "io/pbrt_params.h"
 
+#include "core/spectrum.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -374,14 +376,32 @@ int cdl_pbrt_param_spectrum(cdl_pbrt_params *ps, cdl_pbrt_param *p, cdl_vec3 *ou
                                  "parameter \"%s %s\": unknown named spectrum \"%s\" (spectrum files are not supported)",
                                  p->tname, p->name, nm);
         } else {
-            if (p->n < 2)
+            if (p->n < 2 || p->n % 2)
                 return count_error(ps, p, "wavelength/value pairs", err);
-            double sum = 0.0;
-            for (size_t i = 1; i < p->n; i += 2)
-                sum += v[i];
-            float g = (float)(sum / (double)(p->n / 2));
-            cdl_warn(ps->file, p->line, "sampled spectrum \"%s\" averaged to grey %g", p->name, (double)g);
-            *out = cdl_v3(g, g, g);
+            int n = (int)(p->n / 2);
+            double *lv = malloc(2 * (size_t)n * sizeof *lv);
+            if (!lv)
+                return cdl_error_set(err, CDL_ERR_SYSTEM, ps->file, p->line, "out of memory");
+            for (int i = 0; i < n; i++) {
+                lv[i] = v[2 * i];
+                lv[n + i] = v[2 * i + 1];
+                if (!(lv[i] > 0.0) || (i > 0 && !(lv[i] > lv[i - 1]))) {
+                    free(lv);
+                    return cdl_error_set(err, CDL_ERR_INPUT, ps->file, p->line,
+                                         "parameter \"%s %s\": wavelengths must be positive and increasing (%g after "
+                                         "%g)",
+                                         p->tname, p->name, v[2 * i], i > 0 ? v[2 * i - 2] : 0.0);
+                }
+            }
+            /* through the CIE 1931 observer: a light's L or I as emitted,
+             * everything else (reflectances, eta, k) under D65 so that a
+             * constant stays grey */
+            int emitted = !strcmp(p->name, "L") || !strcmp(p->name, "I");
+            cdl_vec3 rgb = cdl_spectrum_to_srgb(lv, lv + n, n, !emitted);
+            free(lv);
+            /* a saturated spectrum lies outside the sRGB gamut: its nearest
+             * colour inside */
+            *out = cdl_v3(fmaxf(rgb.x, 0.0f), fmaxf(rgb.y, 0.0f), fmaxf(rgb.z, 0.0f));
             return 0;
         }
     default:

@@ -2,6 +2,9 @@
 
 #include "core/sampling.h"
 #include "scene/microfacet.h"
+#include "scene/oren_nayar.h"
+#include "scene/microfacet_mts.h"
+#include "scene/plastic.h"
 
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
                    cdl_vec3 ns, cdl_vec3 ng)
@@ -15,6 +18,14 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->eta3 = m->eta3;
     b->k3 = m->k3;
     b->fresnel = m->fresnel;
+    b->mf = m->mf;
+    b->nonlinear = m->nonlinear;
+    b->spec_weight = m->spec_weight;
+    b->coat_ri = m->coat_ri;
+    b->sigma = m->sigma;
+    b->on_full = m->on_full;
+    b->coat_t = m->coat_t;
+    b->opacity = m->masked ? cdl_minf(1.0f, cdl_maxf(0.0f, m->opacity)) : 1.0f;
     /* below ~1e-4 the GGX lobe underflows in float */
     b->ax = cdl_maxf(m->alpha_x, 1e-4f);
     b->ay = cdl_maxf(m->alpha_y, 1e-4f);
@@ -54,7 +65,8 @@ float cdl_fresnel_dielectric(float cos_i, float eta)
 static int is_opaque(const cdl_bsdf *b)
 {
     return b->type == CDL_MAT_DIFFUSE || b->type == CDL_MAT_PHONG || b->type == CDL_MAT_CONDUCTOR ||
-           b->type == CDL_MAT_PLASTIC;
+           b->type == CDL_MAT_PLASTIC || b->type == CDL_MAT_COATED || b->type == CDL_MAT_ROUGH_COATED ||
+           b->type == CDL_MAT_ROUGH_DIFFUSE;
 }
 
 /* Opaque materials are two-sided: both directions are mirrored to the
@@ -118,11 +130,22 @@ static cdl_vec3 opaque_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *
     float pd = li.z * CDL_INV_PI, ps, cos_h;
     cdl_vec3 f = cdl_scale(b->kd, CDL_INV_PI);
     switch (b->type) {
+    case CDL_MAT_ROUGH_DIFFUSE: /* sampled as Lambert: by the cosine */
+        *pdf = pd;
+        return cdl_oren_nayar(b->kd, b->sigma, b->on_full, lo, li);
     case CDL_MAT_PHONG:
         f = cdl_madd(f, b->ks, phong_lobe(b->ns, lo, li, &ps));
         *pdf = (1.0f - b->p_spec) * pd + b->p_spec * ps;
         return f;
     case CDL_MAT_CONDUCTOR: {
+        if (b->mf != CDL_MF_PBRT) { /* Mitsuba's roughconductor */
+            cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+            cdl_vec3 h = cdl_normalize(cdl_add(lo, li));
+            float D = cdl_mf_D(&d, h), g1o = cdl_mf_G1(&d, lo, h);
+            *pdf = D * g1o / (4.0f * lo.z);
+            float v = D * g1o * cdl_mf_G1(&d, li, h) / (4.0f * lo.z * li.z);
+            return cdl_scale(cdl_mul(b->ks, cdl_fresnel_conductor(cdl_dot(lo, h), b->eta3, b->k3)), v);
+        }
         float m = ggx_reflect(b, lo, li, pdf, &cos_h);
         /* ks: Mitsuba's specular_reflectance factor (1 for pbrt's metals) */
         return cdl_scale(cdl_mul(b->ks, cdl_fresnel_conductor(cos_h, b->eta3, b->k3)), m);
@@ -133,6 +156,9 @@ static cdl_vec3 opaque_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, float *
         *pdf = (1.0f - b->p_spec) * pd + b->p_spec * ps;
         return f;
     }
+    case CDL_MAT_COATED:
+    case CDL_MAT_ROUGH_COATED:
+        return cdl_coat_eval(b, lo, li, pdf);
     default:
         *pdf = pd;
         return f;
@@ -160,8 +186,17 @@ static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, in
         return zero; /* back-facing microfacet */
     float F = cdl_fresnel_dielectric(dio, b->eta);
     cdl_vec3 v = co > 0.0f ? lo : cdl_neg(lo); /* the viewer, on the +z side */
-    float pm = cdl_ggx_pdf_vndf(v, wm, b->ax, b->ay);
-    float D = cdl_ggx_D(wm, b->ax, b->ay), G = cdl_ggx_G(lo, li, b->ax, b->ay);
+    float pm, D, G;
+    if (b->mf != CDL_MF_PBRT) { /* Mitsuba's distributions, separable G */
+        cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+        pm = cdl_mf_pdf_vndf(&d, v, wm);
+        D = cdl_mf_D(&d, wm);
+        G = cdl_mf_G1(&d, lo, wm) * cdl_mf_G1(&d, li, wm);
+    } else {
+        pm = cdl_ggx_pdf_vndf(v, wm, b->ax, b->ay);
+        D = cdl_ggx_D(wm, b->ax, b->ay);
+        G = cdl_ggx_G(lo, li, b->ax, b->ay);
+    }
     if (reflect) {
         *pdf = pm / (4.0f * fabsf(dio)) * F;
         return cdl_scale(b->ks, D * G * F / fabsf(4.0f * ci * co));
@@ -175,7 +210,7 @@ static cdl_vec3 rough_glass_eval(const cdl_bsdf *b, cdl_vec3 lo, cdl_vec3 li, in
     return cdl_scale(b->kt, ft);
 }
 
-cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
+static cdl_vec3 eval_opaque_or_glass(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
     cdl_vec3 lo, li;
     float pdf;
@@ -191,7 +226,7 @@ cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
     return opaque_eval(b, lo, li, &pdf);
 }
 
-float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+static float pdf_opaque_or_glass(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
     float pdf = 0.0f;
@@ -221,7 +256,28 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     if (lo.z <= 0.0f)
         return 0;
     cdl_vec3 li;
-    if (b->type == CDL_MAT_CONDUCTOR || (b->type == CDL_MAT_PLASTIC && u0 < b->p_spec)) {
+    if (b->type == CDL_MAT_COATED || b->type == CDL_MAT_ROUGH_COATED) {
+        int delta;
+        cdl_vec3 w;
+        float p;
+        cdl_coat_sample(b, lo, u0, u1, u2, &li, &delta, &w, &p);
+        if (delta) {
+            if (li.z <= 0.0f)
+                return 0;
+            s->wi = cdl_to_world(&b->frame, cdl_v3(li.x, li.y, li.z * side));
+            float gi = cdl_dot(s->wi, b->ng);
+            if (gi * go <= 0.0f || fabsf(gi) < 1e-6f)
+                return 0;
+            s->delta = 1;
+            s->pdf = p;
+            s->weight = w;
+            return 1;
+        }
+    } else if (b->type == CDL_MAT_CONDUCTOR && b->mf != CDL_MF_PBRT) {
+        cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+        cdl_vec3 h = cdl_mf_sample_vndf(&d, lo, u1, u2);
+        li = cdl_sub(cdl_scale(h, 2.0f * cdl_dot(lo, h)), lo);
+    } else if (b->type == CDL_MAT_CONDUCTOR || (b->type == CDL_MAT_PLASTIC && u0 < b->p_spec)) {
         cdl_vec3 h = cdl_ggx_sample_vndf(lo, b->ax, b->ay, u1, u2);
         li = cdl_sub(cdl_scale(h, 2.0f * cdl_dot(lo, h)), lo);
     } else if (b->type == CDL_MAT_PHONG && u0 < b->p_spec) {
@@ -259,8 +315,13 @@ static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     cdl_vec3 lo = cdl_to_local(&b->frame, wo);
     if (lo.z == 0.0f)
         return 0;
-    cdl_vec3 v = lo.z > 0.0f ? lo : cdl_neg(lo);
-    cdl_vec3 wm = cdl_ggx_sample_vndf(v, b->ax, b->ay, u1, u2);
+    cdl_vec3 v = lo.z > 0.0f ? lo : cdl_neg(lo), wm;
+    if (b->mf != CDL_MF_PBRT) {
+        cdl_mf d = cdl_mf_make((cdl_mf_type)b->mf, b->ax, b->ay);
+        wm = cdl_mf_sample_vndf(&d, v, u1, u2);
+    } else {
+        wm = cdl_ggx_sample_vndf(v, b->ax, b->ay, u1, u2);
+    }
     float dio = cdl_dot(lo, wm);
     float F = cdl_fresnel_dielectric(dio, b->eta);
     cdl_vec3 li;
@@ -296,8 +357,8 @@ static int sample_rough_glass(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     return 1;
 }
 
-int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
-                    int adjoint, cdl_scatter *s)
+static int sample_any(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
+                      int adjoint, cdl_scatter *s)
 {
     if (b->type == CDL_MAT_MIRROR) {
         cdl_vec3 n = b->frame.n;
@@ -341,4 +402,34 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC)
         return sample_rough_glass(b, wo, u0, u1, u2, adjoint, s);
     return sample_opaque(b, wo, u0, u1, u2, s);
+}
+
+/* Mitsuba's mask: the material scatters with probability opacity and
+ * lets the rest pass straight on (a Dirac component, weight 1). */
+cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
+{
+    return cdl_scale(eval_opaque_or_glass(b, wo, wi, adjoint), b->opacity);
+}
+
+float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
+{
+    return pdf_opaque_or_glass(b, wo, wi) * b->opacity;
+}
+
+int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
+                    int adjoint, cdl_scatter *s)
+{
+    if (b->opacity >= 1.0f)
+        return sample_any(b, wo, u0, u1, u2, adjoint, s);
+    if (u0 >= b->opacity) {
+        s->wi = cdl_neg(wo);
+        s->weight = cdl_v3(1.0f, 1.0f, 1.0f);
+        s->pdf = 1.0f - b->opacity;
+        s->delta = 1;
+        return 1;
+    }
+    if (!sample_any(b, wo, u0 / b->opacity, u1, u2, adjoint, s))
+        return 0;
+    s->pdf *= b->opacity; /* the weight keeps opacity f / (opacity pdf) */
+    return 1;
 }

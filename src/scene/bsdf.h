@@ -16,6 +16,12 @@ typedef struct cdl_bsdf {
     float ax, ay;       /* GGX roughness */
     float p_spec;    /* probability of sampling the specular lobe (Phong, plastic) */
     int fresnel;     /* mirror: ks times the conductor Fresnel term of eta3, k3 */
+    int mf, nonlinear;           /* coated (plastic.h) */
+    float spec_weight, coat_ri;
+    float sigma;        /* rough diffuse */
+    int on_full;
+    const float *coat_t;         /* the material's table: it outlives the bsdf */
+    float opacity;   /* < 1: the rest passes straight through (Mitsuba's mask) */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
 } cdl_bsdf;
@@ -27,14 +33,19 @@ typedef struct cdl_scatter {
     int delta;       /* 1 if wi came from a specular (Dirac) component */
 } cdl_scatter;
 
-/* Builds the BSDF at a hit: kd already includes the texture. */
+/* Builds the BSDF at a hit: kd already includes the texture; the opacity
+ * is the material's, to be multiplied by its texture by the caller. */
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
                    cdl_vec3 ns, cdl_vec3 ng);
 
+/* Every component is Dirac (a mask adds one more: passing through). */
 static inline int cdl_bsdf_is_delta(const cdl_bsdf *b)
 {
     return cdl_mat_is_delta(b->type);
 }
+
+/* eval and pdf cover the non-Dirac components only; a sample reports
+ * which kind it drew in cdl_scatter.delta. */
 
 cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint);
 float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi);

@@ -14,8 +14,16 @@ typedef enum cdl_mat_type {
     CDL_MAT_DIELECTRIC,      /* smooth glass of index eta; reflectance ks, transmittance kt */
     CDL_MAT_CONDUCTOR,       /* GGX microfacet metal: complex index eta3 + i k3, roughness alpha */
     CDL_MAT_PLASTIC,         /* Lambert kd + GGX dielectric reflection ks (index eta), as pbrt-v3 */
-    CDL_MAT_ROUGH_DIELECTRIC /* GGX microfacet glass of index eta; ks, kt */
+    CDL_MAT_ROUGH_DIELECTRIC, /* GGX microfacet glass of index eta; ks, kt */
+    CDL_MAT_COATED,          /* Mitsuba's plastic: diffuse base kd under a smooth dielectric coat of
+                              * index eta reflecting ks F (a Dirac lobe); see plastic.h */
+    CDL_MAT_ROUGH_COATED,    /* Mitsuba's roughplastic: the same under a rough coat (mf, alpha_x) */
+    CDL_MAT_ROUGH_DIFFUSE    /* Oren-Nayar of reflectance kd, slope deviation sigma (oren_nayar.h) */
 } cdl_mat_type;
+
+/* Entries of the rough coat's transmittance table (Mitsuba's
+ * MI_ROUGH_TRANSMITTANCE_RES), over cos theta in [0, 1]. */
+#define CDL_COAT_RES 64
 
 /* Scatters only in Dirac directions (mirror, smooth glass): never connected
  * to, never stores photons. */
@@ -32,6 +40,19 @@ typedef struct cdl_material {
     cdl_vec3 eta3, k3; /* conductor: complex index of refraction per channel */
     float alpha_x, alpha_y; /* GGX roughness (alpha, not pbrt's "roughness") */
     int fresnel;      /* mirror: reflectance ks times the conductor Fresnel term */
+    /* coated (Mitsuba's plastics), filled by cdl_coat_prepare but spec_weight */
+    int mf;            /* microfacet model of rough coats and conductors (cdl_mf_type; 0 = pbrt's) */
+    int nonlinear;     /* internal reflections tint the base (Mitsuba's `nonlinear`) */
+    float spec_weight; /* Mitsuba's specular_sampling_weight: ks / (kd + ks) in means */
+    float coat_ri;     /* diffuse reflectance of the coat seen from inside */
+    float coat_t[CDL_COAT_RES]; /* rough coat: transmittance from outside against cos theta */
+    /* Mitsuba's mask: where opacity (times the texture's luminance) < 1 the
+     * surface lets light pass straight through, as a Dirac component */
+    float sigma;       /* rough diffuse: Oren-Nayar's sigma in radians */
+    int on_full;       /* rough diffuse: the full model (Mitsuba 0.6), else the qualitative (pbrt) */
+    int masked;
+    float opacity;
+    int opacity_tex;  /* texture index or -1 */
     char name[64];
 } cdl_material;
 

@@ -536,4 +536,7 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
     if (m->kd_tex >= 0)
         kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
+    if (m->masked && m->opacity_tex >= 0)
+        b->opacity *= cdl_minf(1.0f, cdl_maxf(0.0f, cdl_luminance(cdl_texture_lookup(&s->texs[m->opacity_tex],
+                                                                                      sf->u, sf->v))));
 }

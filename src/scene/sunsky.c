@@ -256,6 +256,7 @@ void cdl_sunsky_params_init(cdl_sunsky_params *p)
     p->sun_above_only = 0;
     p->width = 512;
     p->height = 256;
+    p->node_rows = 0;
 }
 
 cdl_vec3 cdl_sunsky_sun_dir(const cdl_sunsky_params *p)
@@ -285,7 +286,7 @@ int cdl_sunsky_image(const cdl_sunsky_params *p, float **out, cdl_error *err)
 {
     int w = p->width, h = p->height;
     *out = NULL;
-    if (w < 2 || h < 1)
+    if (w < 2 || h < 2)
         return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "a %dx%d sky image is too small", w, h);
     float *rgb = calloc((size_t)w * (size_t)h * 3, sizeof(float));
     if (!rgb)
@@ -294,7 +295,7 @@ int cdl_sunsky_image(const cdl_sunsky_params *p, float **out, cdl_error *err)
         cdl_sky_model sky;
         cdl_sky_init(&sky, p->turbidity, p->albedo, p->sun_zenith, p->sun_azimuth, p->stretch, p->extend);
         for (int y = 0; y < h; y++) {
-            double theta = (y + 0.5) * PI / h;
+            double theta = p->node_rows ? y * PI / (h - 1) : (y + 0.5) * PI / h;
             for (int x = 0; x < w; x++) {
                 cdl_vec3 L = cdl_sky_radiance(&sky, theta, (x + 0.5) * 2.0 * PI / w);
                 float *t = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
@@ -313,7 +314,9 @@ int cdl_sunsky_image(const cdl_sunsky_params *p, float **out, cdl_error *err)
         size_t n = (size_t)fmax(100.0, (double)w * (double)h * covered * 1000.0);
         if (n > 1u << 24)
             n = 1u << 24;
-        double k = cdl_sun_solid_angle() * p->sun_scale * w * h / (2.0 * PI * PI * (double)n);
+        /* a texel's (or node's) solid angle is 2 pi^2 / (w rows) sin(theta) */
+        const double rows = p->node_rows ? h - 1 : h;
+        double k = cdl_sun_solid_angle() * p->sun_scale * w * rows / (2.0 * PI * PI * (double)n);
         cdl_frame fr = cdl_frame_from(cdl_sunsky_sun_dir(p));
         for (size_t i = 0; i < n; i++) {
             double u, v;
@@ -325,10 +328,10 @@ int cdl_sunsky_image(const cdl_sunsky_params *p, float **out, cdl_error *err)
                 continue;
             double zen, az;
             cdl_sunsky_angles(d, &zen, &az);
-            int x = (int)(az * w / (2.0 * PI)), y = (int)(zen * h / PI);
+            int x = (int)(az * w / (2.0 * PI));
+            int y = p->node_rows ? (int)floor(zen * (h - 1) / PI + 0.5) : (int)(zen * h / PI);
             x = x < 0 ? 0 : x >= w ? w - 1 : x;
             y = y < 0 ? 0 : y >= h ? h - 1 : y;
-            /* the texel's solid angle is 2 pi^2 / (w h) sin(theta) */
             double f = k / fmax(1e-3, sqrt(fmax(0.0, 1.0 - (double)d.y * d.y)));
             float *t = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
             t[0] += (float)(L.x * f);

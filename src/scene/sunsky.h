@@ -9,8 +9,9 @@
  * zenith angle theta and azimuth phi lies at
  *   (sin phi sin theta, cos theta, -cos phi sin theta)
  * (Mitsuba 0.6's toSphere: azimuth 0 is -z, 90 degrees +x). The image's
- * texel (x, y) of a w x h image is the direction at theta = (y + 1/2) pi / h,
- * phi = (x + 1/2) 2 pi / w; radiances in W / (m^2 sr nm), as Mitsuba's. */
+ * texel (x, y) of a w x h image is the direction at theta = (y + 1/2) pi / h
+ * (or y pi / (h - 1), node_rows), phi = (x + 1/2) 2 pi / w; radiances in
+ * W / (m^2 sr nm), as Mitsuba's. */
 #ifndef CDL_SUNSKY_H
 #define CDL_SUNSKY_H
 
@@ -69,6 +70,8 @@ typedef struct cdl_sunsky_params {
     double sun_radius_scale; /* > 0: the disk's radius over the sun's, its power kept */
     int sun_above_only;      /* drop the part of the disk below the horizon (Mitsuba 3) */
     int width, height;       /* the image, width x height texels */
+    int node_rows;           /* rows at theta = y pi / (h - 1), the nodes of Mitsuba 3's
+                                bilinear envmap; else at (y + 1/2) pi / h, as Mitsuba 0.6 */
 } cdl_sunsky_params;
 
 void cdl_sunsky_params_init(cdl_sunsky_params *p);
