@@ -512,6 +512,80 @@ static void envmap_orientation(void)
     cdl_scene_free(&s);
 }
 
+/* Mitsuba's daylight emitters: the sun where sunDirection puts it in Mitsuba
+ * 0.6's y-up frame and in Mitsuba 3's z-up one, nothing below the horizon,
+ * "sky" and "sun" merged into one environment light equal to "sunsky", and
+ * a sun of radius 0 as a distant light. */
+static void sunsky(void)
+{
+    const char *v06 = "<scene version=\"0.6.0\">\n<shape type=\"rectangle\"/>\n";
+    char text[2048];
+    snprintf(text, sizeof text,
+             "%s<emitter type=\"sunsky\"><vector name=\"sunDirection\" x=\"1\" y=\"1\" z=\"0\"/>"
+             "<integer name=\"resolution\" value=\"256\"/></emitter>\n</scene>\n",
+             v06);
+    write_file("sunsky06.xml", text);
+    snprintf(text, sizeof text,
+             "%s<emitter type=\"sky\"><vector name=\"sunDirection\" x=\"1\" y=\"1\" z=\"0\"/>"
+             "<integer name=\"resolution\" value=\"256\"/></emitter>\n"
+             "<emitter type=\"sun\"><vector name=\"sunDirection\" x=\"1\" y=\"1\" z=\"0\"/>"
+             "<integer name=\"resolution\" value=\"256\"/></emitter>\n</scene>\n",
+             v06);
+    write_file("skysun06.xml", text);
+    snprintf(text, sizeof text,
+             "%s<emitter type=\"sunsky\"><vector name=\"sunDirection\" x=\"1\" y=\"1\" z=\"0\"/>"
+             "<float name=\"sunRadiusScale\" value=\"0\"/></emitter>\n</scene>\n",
+             v06);
+    write_file("sundir06.xml", text);
+    write_file("sunsky3.xml", "<scene version=\"3.0.0\">\n<shape type=\"rectangle\"/>\n<emitter type=\"sunsky\">"
+                              "<vector name=\"sun_direction\" x=\"0\" y=\"1\" z=\"1\"/></emitter>\n</scene>\n");
+    cdl_scene s, t;
+    cdl_scene_settings set;
+    const cdl_vec3 sun06 = unit(cdl_v3(1, 1, 0)), sun3 = unit(cdl_v3(0, 1, 1));
+    if (!load("sunsky06.xml", &s, &set)) {
+        cdl_vec3 at = cdl_envmap_eval(s.envmap, sun06), up = cdl_envmap_eval(s.envmap, cdl_v3(0, 1, 0));
+        cdl_vec3 down = cdl_envmap_eval(s.envmap, cdl_v3(0.3f, -0.9f, 0.1f));
+        CHECK(s.envmap && at.y > 1e3f * up.y && up.z > up.x && cdl_max3(down) == 0.0f,
+              "sunsky (0.6): the sun %g where sunDirection points, the zenith sky (%g, %g, %g), nothing below",
+              (double)at.y, (double)up.x, (double)up.y, (double)up.z);
+        if (!load("skysun06.xml", &t, &set)) {
+            int same = t.envmap && t.envmap->w == s.envmap->w && t.envmap->h == s.envmap->h;
+            for (int i = 0; same && i < 3 * s.envmap->w * s.envmap->h; i++)
+                same = fabsf(t.envmap->rgb[i] - s.envmap->rgb[i]) <= 1e-5f * fmaxf(1.0f, s.envmap->rgb[i]);
+            CHECK(same && t.nlights == s.nlights, "sky + sun (0.6): one environment light, equal to sunsky's");
+            cdl_scene_free(&t);
+        } else {
+            CHECK(0, "skysun06.xml loads");
+        }
+        if (!load("sundir06.xml", &t, &set)) {
+            int distant = -1;
+            for (uint32_t i = 0; i < t.nlights; i++)
+                if (t.lights[i].type == CDL_LIGHT_DISTANT)
+                    distant = (int)i;
+            cdl_vec3 at0 = t.envmap ? cdl_envmap_eval(t.envmap, sun06) : cdl_v3(0, 0, 0);
+            CHECK(distant >= 0 && near3(t.lights[distant].n, cdl_scale(sun06, -1.0f), 1e-5f) && at0.y < 1.0f,
+                  "sunRadiusScale 0: a distant light along -sunDirection, the sky alone in the map (%g there)",
+                  (double)at0.y);
+            cdl_scene_free(&t);
+        } else {
+            CHECK(0, "sundir06.xml loads");
+        }
+        cdl_scene_free(&s);
+    } else {
+        CHECK(0, "sunsky06.xml loads");
+    }
+    if (!load("sunsky3.xml", &s, &set)) {
+        cdl_vec3 at = cdl_envmap_eval(s.envmap, sun3), up = cdl_envmap_eval(s.envmap, cdl_v3(0, 0, 1));
+        cdl_vec3 down = cdl_envmap_eval(s.envmap, cdl_v3(0.1f, 0.3f, -0.9f));
+        CHECK(at.y > 1e3f * up.y && up.y > 0.0f && cdl_max3(down) == 0.0f,
+              "sunsky (Mitsuba 3, z up): the sun %g along sun_direction, sky %g at +z, nothing at -z", (double)at.y,
+              (double)up.y);
+        cdl_scene_free(&s);
+    } else {
+        CHECK(0, "sunsky3.xml loads");
+    }
+}
+
 /* The shared scenes: load, and the Veach scenes' cameras equal their
  * pbrt-v3 twins'. */
 static void shared_scenes(const char *root)
@@ -642,6 +716,7 @@ int main(int argc, char **argv)
     textures_and_maps();
     instancing();
     envmap_orientation();
+    sunsky();
     if (argc > 1)
         shared_scenes(argv[1]);
     char cmd[300];

@@ -55,6 +55,11 @@ typedef struct cdl_mts_ctx {
     int saw_sensor;
     uint32_t nshapes;
     int in_group;           /* reading the shapes of a shapegroup */
+    int legacy;             /* the main file's version is 0.x: Mitsuba 0.6's conventions where they differ */
+    float *sky_rgb;         /* the daylight emitters' image, added as the environment light at the end */
+    int sky_w, sky_h, sky_line;
+    cdl_vec3 sky_axes[3];
+    char sky_file[1024];
     char buf[4096];         /* an attribute after $variable substitution */
 } cdl_mts_ctx;
 
@@ -118,8 +123,20 @@ int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat
 int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value);
 /* An <emitter type="area"> inside a shape: the scene emitter. */
 int cdl_mts_area(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *emit);
-/* A non-area <emitter> (point, spot, directional, constant, envmap). */
+/* A non-area <emitter> (point, spot, directional, constant, envmap, sunsky, sky, sun). */
 int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n);
+/* A lat-long environment light in Mitsuba's frame and texel layout: axes are
+ * the world images of the map's local x, y (up) and z; the radiance is the
+ * image file path times scale, or (path NULL) the w x h texels rgb, taken
+ * over (freed on failure). envmap and the daylight emitters both come here. */
+int cdl_mts_latlong_light(cdl_mts_ctx *c, int line, const cdl_vec3 axes[3], const char *path, float scale, int w,
+                          int h, float *rgb);
+
+/* mitsuba_sunsky.c */
+/* <emitter type="sunsky|sky|sun">: rasterized into the pending daylight image. */
+int cdl_mts_sunsky(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, const cdl_mat4 *to_world);
+/* Adds the pending daylight image as the environment light (after reading). */
+int cdl_mts_sky_finish(cdl_mts_ctx *c);
 /* Mitsuba's default surface, diffuse 0.5, made on first use. */
 int cdl_mts_default_material(cdl_mts_ctx *c, int32_t *mat);
 

@@ -284,6 +284,8 @@ static int read_file(cdl_mts_ctx *c, const char *path, int line)
         rc = cdl_mts_error(c, doc.root.line, "the document element is <%s>, not <scene>", doc.root.name);
     } else {
         const char *ver = cdl_xml_attr_get(&doc.root, "version");
+        if (c->depth == 1)
+            c->legacy = ver && ver[0] == '0';
         if (ver && !(ver[0] == '0' || !strncmp(ver, "2.", 2) || !strncmp(ver, "3.", 2)))
             cdl_mts_warn(c, doc.root.line, "scene version \"%s\": read as Mitsuba 3", ver);
         for (int i = 0; i < doc.root.nkids && !rc; i++)
@@ -327,6 +329,9 @@ int cdl_load_mitsuba(cdl_scene *s, const char *path, const char (*defs)[CDL_DEFI
     }
     if (!rc)
         rc = read_file(c, path, 0);
+    if (!rc)
+        rc = cdl_mts_sky_finish(c);
+    free(c->sky_rgb);
     for (int i = 0; !rc && i < c->nvars; i++)
         if (c->vars[i].given && !c->vars[i].used)
             cdl_warn(path, 0, "define \"%s\": the scene has no such parameter (ignored)", c->vars[i].name);

@@ -502,6 +502,35 @@ int cdl_mts_area(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *emit)
     return cdl_mts_scene_rc(c, n->line, cdl_scene_add_emitter(c->s, L, 0, emit, c->err));
 }
 
+int cdl_mts_latlong_light(cdl_mts_ctx *c, int line, const cdl_vec3 axes[3], const char *path, float scale, int w,
+                          int h, float *rgb)
+{
+    /* Mitsuba's map is y-up with u = atan2(x, -z) / 2 pi: pbrt-v3's z-up
+     * frame with x' = -z, y' = x, z' = y */
+    cdl_vec3 frame[3] = {cdl_scale(axes[2], -1.0f), axes[0], axes[1]};
+    /* the texel layout of Mitsuba's lat-long maps, one place for envmap and sunsky */
+    const int layout = CDL_ENVMAP_MITSUBA;
+    cdl_envmap *em = malloc(sizeof *em);
+    if (!em) {
+        free(rgb);
+        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, line, "out of memory");
+    }
+    int rc;
+    if (path) {
+        rc = cdl_envmap_load(em, path, cdl_v3(scale, scale, scale), frame, layout, c->err);
+    } else {
+        rc = cdl_envmap_init(em, w, h, rgb, frame, layout, c->err);
+        if (rc == CDL_ERR_INPUT) /* refused before it took the texels over */
+            free(rgb);
+        rc = cdl_mts_scene_rc(c, line, rc);
+    }
+    if (rc) {
+        free(em);
+        return rc;
+    }
+    return cdl_mts_scene_rc(c, line, cdl_scene_add_env_light(c->s, cdl_v3(1, 1, 1), em, c->err));
+}
+
 static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
 {
     char fn[1024], path[1024];
@@ -519,19 +548,9 @@ static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
     cdl_mts_prop(c, n, "gamma");
     cdl_mts_prop(c, n, "cache");
     cdl_mts_prop(c, n, "filter_type");
-    /* Mitsuba's map is y-up with u = atan2(x, -z) / 2 pi: pbrt-v3's z-up
-     * frame with x' = -z, y' = x, z' = y */
-    cdl_vec3 frame[3] = {cdl_scale(cdl_mat4_vector3(m, cdl_v3(0, 0, 1)), -1.0f), cdl_mat4_vector3(m, cdl_v3(1, 0, 0)),
-                         cdl_mat4_vector3(m, cdl_v3(0, 1, 0))};
-    cdl_envmap *em = malloc(sizeof *em);
-    if (!em)
-        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, n->line, "out of memory");
-    float s = (float)scale;
-    if ((rc = cdl_envmap_load(em, path, cdl_v3(s, s, s), frame, CDL_ENVMAP_MITSUBA, c->err))) {
-        free(em);
-        return rc;
-    }
-    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_env_light(c->s, cdl_v3(1, 1, 1), em, c->err));
+    cdl_vec3 axes[3] = {cdl_mat4_vector3(m, cdl_v3(1, 0, 0)), cdl_mat4_vector3(m, cdl_v3(0, 1, 0)),
+                        cdl_mat4_vector3(m, cdl_v3(0, 0, 1))};
+    return cdl_mts_latlong_light(c, n->line, axes, path, (float)scale, 0, 0, NULL);
 }
 
 int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
@@ -599,6 +618,14 @@ int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
         if ((rc = envmap(c, n, &m)))
             return rc;
         cdl_mts_warn_unused(c, n, "emitter \"envmap\"");
+        return 0;
+    }
+    if (!strcmp(type, "sunsky") || !strcmp(type, "sky") || !strcmp(type, "sun")) {
+        if ((rc = cdl_mts_sunsky(c, n, type, &m)))
+            return rc;
+        char what[80];
+        snprintf(what, sizeof what, "emitter \"%s\"", type);
+        cdl_mts_warn_unused(c, n, what);
         return 0;
     }
     cdl_mts_warn(c, n->line, "emitter \"%s\" is not supported (ignored)", type);
