@@ -1,6 +1,7 @@
 #include "scene/bsdf.h"
 
 #include "core/sampling.h"
+#include "scene/bsdf_principled.h"
 #include "scene/microfacet.h"
 
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
@@ -25,6 +26,8 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
         ns = cdl_neg(ns);
     b->frame = cdl_frame_from(ns);
     b->p_spec = 0.0f;
+    if (b->type == CDL_MAT_PRINCIPLED) /* constants; cdl_scene_bsdf adds textures */
+        cdl_principled_at_init(&b->pr, &m->pr, NULL, 0.0f, 0.0f);
     if (b->type == CDL_MAT_PHONG) {
         /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
          * proportion keeps every sample's weight within Kd + Ks (n+2)/(n+1) */
@@ -179,6 +182,8 @@ cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 {
     cdl_vec3 lo, li;
     float pdf;
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_eval(b, wo, wi, adjoint);
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
         /* the geometric sides decide reflection vs transmission */
         if (cdl_dot(wo, b->ng) * cdl_dot(wi, b->ng) * (cdl_to_local(&b->frame, wo).z *
@@ -195,6 +200,8 @@ float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
     float pdf = 0.0f;
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_pdf(b, wo, wi);
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
         lo = cdl_to_local(&b->frame, wo);
         li = cdl_to_local(&b->frame, wi);
@@ -340,5 +347,7 @@ int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2
     }
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC)
         return sample_rough_glass(b, wo, u0, u1, u2, adjoint, s);
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_sample(b, wo, u0, u1, u2, adjoint, s);
     return sample_opaque(b, wo, u0, u1, u2, s);
 }

@@ -16,6 +16,7 @@ typedef struct cdl_bsdf {
     float ax, ay;       /* GGX roughness */
     float p_spec;    /* probability of sampling the specular lobe (Phong, plastic) */
     int fresnel;     /* mirror: ks times the conductor Fresnel term of eta3, k3 */
+    cdl_principled_at pr; /* principled: parameters at the hit */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
 } cdl_bsdf;

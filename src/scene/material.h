@@ -5,6 +5,7 @@
 #define CDL_MATERIAL_H
 
 #include "core/vec.h"
+#include "scene/bsdf_principled.h"
 
 typedef enum cdl_mat_type {
     CDL_MAT_DIFFUSE,         /* Lambert: kd */
@@ -14,7 +15,8 @@ typedef enum cdl_mat_type {
     CDL_MAT_DIELECTRIC,      /* smooth glass of index eta; reflectance ks, transmittance kt */
     CDL_MAT_CONDUCTOR,       /* GGX microfacet metal: complex index eta3 + i k3, roughness alpha */
     CDL_MAT_PLASTIC,         /* Lambert kd + GGX dielectric reflection ks (index eta), as pbrt-v3 */
-    CDL_MAT_ROUGH_DIELECTRIC /* GGX microfacet glass of index eta; ks, kt */
+    CDL_MAT_ROUGH_DIELECTRIC, /* GGX microfacet glass of index eta; ks, kt */
+    CDL_MAT_PRINCIPLED       /* Mitsuba 3's principled(thin): base colour kd, the rest in pr */
 } cdl_mat_type;
 
 /* Scatters only in Dirac directions (mirror, smooth glass): never connected
@@ -32,6 +34,7 @@ typedef struct cdl_material {
     cdl_vec3 eta3, k3; /* conductor: complex index of refraction per channel */
     float alpha_x, alpha_y; /* GGX roughness (alpha, not pbrt's "roughness") */
     int fresnel;      /* mirror: reflectance ks times the conductor Fresnel term */
+    cdl_principled pr; /* principled: parameters other than the base colour */
     char name[64];
 } cdl_material;
 

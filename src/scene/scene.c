@@ -529,6 +529,25 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
     sf->light = s->tri_light[h->prim];
 }
 
+/* dp/du of a triangle's uv parameterization (zero without uv or when the
+ * uvs are degenerate): Mitsuba's shading tangent. */
+static cdl_vec3 triangle_dpdu(const cdl_scene *s, const cdl_surface *sf)
+{
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    if (sf->geom != CDL_GEOM_TRIANGLES || !(s->tri_flags[sf->prim] & CDL_TRI_HAS_UV))
+        return zero;
+    const uint32_t *t = s->idx + 3 * (size_t)sf->prim;
+    const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1], *p2 = s->pos + 3 * (size_t)t[2];
+    const float *u0 = s->uv + 2 * (size_t)t[0], *u1 = s->uv + 2 * (size_t)t[1], *u2 = s->uv + 2 * (size_t)t[2];
+    float du0 = u1[0] - u0[0], dv0 = u1[1] - u0[1], du1 = u2[0] - u0[0], dv1 = u2[1] - u0[1];
+    float det = du0 * dv1 - dv0 * du1;
+    if (det == 0.0f || !isfinite(det))
+        return zero;
+    cdl_vec3 dp0 = cdl_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]);
+    cdl_vec3 dp1 = cdl_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]);
+    return cdl_scale(cdl_sub(cdl_scale(dp0, dv1), cdl_scale(dp1, dv0)), 1.0f / det);
+}
+
 void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
 {
     const cdl_material *m = &s->mats[sf->mat];
@@ -536,4 +555,8 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
     if (m->kd_tex >= 0)
         kd = cdl_mul(kd, cdl_texture_lookup(&s->texs[m->kd_tex], sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
+    if (m->type == CDL_MAT_PRINCIPLED) {
+        cdl_principled_at_init(&b->pr, &m->pr, s->texs, sf->u, sf->v);
+        cdl_principled_tangent(b, triangle_dpdu(s, sf));
+    }
 }
