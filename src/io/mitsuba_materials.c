@@ -337,6 +337,91 @@ static int mask(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     return 0;
 }
 
+/* Mitsuba 3's principled and principledthin: every parameter but eta and
+ * the sampling rates may be a texture (its scale times its value at the
+ * hit). Out-of-range constants would make lobe weights negative: clamped
+ * to Mitsuba's documented ranges, with a warning. */
+static int principled(cdl_mts_ctx *c, cdl_xml_node *n, int thin, cdl_material *m)
+{
+    static const struct {
+        const char *name;
+        int slot, where; /* where: 0 both, 1 principled only, 2 thin only */
+        float max;
+    } P[] = {{"roughness", CDL_PR_ROUGHNESS, 0, 1},   {"anisotropic", CDL_PR_ANISOTROPIC, 0, 1},
+             {"metallic", CDL_PR_METALLIC, 1, 1},     {"spec_trans", CDL_PR_SPEC_TRANS, 0, 1},
+             {"spec_tint", CDL_PR_SPEC_TINT, 0, 1},   {"sheen", CDL_PR_SHEEN, 0, 1},
+             {"sheen_tint", CDL_PR_SHEEN_TINT, 0, 1}, {"flatness", CDL_PR_FLATNESS, 0, 1},
+             {"clearcoat", CDL_PR_CLEARCOAT, 1, 1},   {"clearcoat_gloss", CDL_PR_CC_GLOSS, 1, 1},
+             {"diff_trans", CDL_PR_DIFF_TRANS, 2, 2}, {"eta", CDL_PR_ETA, 2, 100}};
+    static const char *const RATES[2][CDL_PR_NRATES] = {
+        {"diffuse_reflectance_sampling_rate", "main_specular_sampling_rate", "clearcoat_sampling_rate", NULL},
+        {"diffuse_reflectance_sampling_rate", "specular_reflectance_sampling_rate",
+         "specular_transmittance_sampling_rate", "diffuse_transmittance_sampling_rate"}};
+    int rc;
+    *m = cdl_material_default(CDL_MAT_PRINCIPLED);
+    m->pr = cdl_principled_default(thin);
+    if ((rc = color(c, n, "base_color", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)))
+        return rc;
+    m->kd = at_most_one(c, n->line, "base_color", m->kd);
+    for (size_t i = 0; i < sizeof P / sizeof P[0]; i++) {
+        if (P[i].where == (thin ? 1 : 2))
+            continue;
+        float def = m->pr.value[P[i].slot];
+        cdl_vec3 v;
+        if ((rc = color(c, n, P[i].name, cdl_v3(def, def, def), &v, &m->pr.tex[P[i].slot])))
+            return rc;
+        /* a colour where a float belongs: its luminance (Mitsuba's eval_1) */
+        float x = 0.212671f * v.x + 0.715160f * v.y + 0.072169f * v.z;
+        if (x > P[i].max || (P[i].slot == CDL_PR_ETA && !(x > 0.0f))) {
+            cdl_mts_warn(c, n->line, "%s %g is outside Mitsuba's range [0, %g]: clamped", P[i].name, (double)x,
+                         (double)P[i].max);
+            x = x > P[i].max ? P[i].max : 1.0f;
+        }
+        m->pr.value[P[i].slot] = x;
+    }
+    for (int i = 0; i < CDL_PR_NRATES; i++) {
+        double r;
+        if (!RATES[thin][i])
+            continue;
+        if ((rc = cdl_mts_float(c, n, RATES[thin][i], 1.0, &r)))
+            return rc;
+        if (!(r >= 0.0 && r <= 1e6))
+            return cdl_mts_error(c, n->line, "%s %g must be in [0, 1e6]", RATES[thin][i], r);
+        m->pr.rate[i] = (float)r;
+    }
+    if (thin)
+        return 0;
+    /* principled: eta, or specular with eta = 2 / (1 - sqrt(0.08 specular)) - 1 */
+    cdl_xml_node *pt = cdl_mts_prop(c, n, "spec_trans");
+    int has_trans = pt && (strcmp(pt->name, "float") || m->pr.value[CDL_PR_SPEC_TRANS] != 0.0f);
+    cdl_xml_node *pe = cdl_mts_prop(c, n, "eta"), *ps = cdl_mts_prop(c, n, "specular");
+    double x;
+    if (pe && ps)
+        return cdl_mts_error(c, n->line, "principled: give either eta or specular, not both");
+    if (pe) {
+        pe->used = 0;
+        if ((rc = cdl_mts_float(c, n, "eta", 1.5, &x)))
+            return rc;
+        if (!(x > 0.0 && x < 100.0))
+            return cdl_mts_error(c, pe->line, "eta %g must be in (0, 100)", x);
+        if (has_trans && x == 1.0)
+            x = 1.001; /* Mitsuba: eta 1 is not plausible for transmission */
+    } else if (ps) {
+        ps->used = 0;
+        if ((rc = cdl_mts_float(c, n, "specular", 0.5, &x)))
+            return rc;
+        if (!(x >= 0.0 && x <= 10.0))
+            return cdl_mts_error(c, ps->line, "specular %g must be in [0, 10]", x);
+        if (has_trans && x == 0.0)
+            x = 1e-3; /* as Mitsuba: specular 0 means eta 1 */
+        x = 2.0 / (1.0 - sqrt(0.08 * x)) - 1.0;
+    } else {
+        x = m->pr.value[CDL_PR_ETA];
+    }
+    m->pr.value[CDL_PR_ETA] = (float)x;
+    return 0;
+}
+
 int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
     char type[64];
@@ -417,6 +502,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             m.kd = cdl_scale(m.kd, sc);
             m.ks = cdl_scale(m.ks, sc);
         }
+    } else if (!strcmp(type, "principled") || !strcmp(type, "principledthin")) {
+        rc = principled(c, n, type[10] == 't', &m);
     } else if (!strcmp(type, "null")) {
         cdl_mts_warn_unused(c, n, "bsdf \"null\"");
         *mat = -1;

@@ -1,6 +1,7 @@
 #include "scene/bsdf.h"
 
 #include "core/sampling.h"
+#include "scene/bsdf_principled.h"
 #include "scene/microfacet.h"
 #include "scene/oren_nayar.h"
 #include "scene/microfacet_mts.h"
@@ -38,6 +39,8 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->nb = ns;
     b->perturbed = 0;
     b->p_spec = 0.0f;
+    if (b->type == CDL_MAT_PRINCIPLED) /* constants; cdl_scene_bsdf adds textures */
+        cdl_principled_at_init(&b->pr, &m->pr, NULL, 0.0f, 0.0f);
     if (b->type == CDL_MAT_PHONG) {
         /* the lobe's weight reaches ks (n+2)/(n+1): choosing it in that
          * proportion keeps every sample's weight within Kd + Ks (n+2)/(n+1) */
@@ -216,6 +219,8 @@ static cdl_vec3 eval_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, in
 {
     cdl_vec3 lo, li;
     float pdf;
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_eval(b, wo, wi, adjoint);
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
         /* the geometric sides decide reflection vs transmission */
         if (cdl_dot(wo, b->ng) * cdl_dot(wi, b->ng) * (cdl_to_local(&b->frame, wo).z *
@@ -232,6 +237,8 @@ static float pdf_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     cdl_vec3 lo, li;
     float pdf = 0.0f;
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_pdf(b, wo, wi);
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC) {
         lo = cdl_to_local(&b->frame, wo);
         li = cdl_to_local(&b->frame, wi);
@@ -403,6 +410,8 @@ static int sample_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1
     }
     if (b->type == CDL_MAT_ROUGH_DIELECTRIC)
         return sample_rough_glass(b, wo, u0, u1, u2, adjoint, s);
+    if (b->type == CDL_MAT_PRINCIPLED)
+        return cdl_principled_sample(b, wo, u0, u1, u2, adjoint, s);
     return sample_opaque(b, wo, u0, u1, u2, s);
 }
 

@@ -22,6 +22,7 @@ typedef struct cdl_bsdf {
     int on_full;
     const float *coat_t;         /* the material's table: it outlives the bsdf */
     float opacity;   /* < 1: the rest passes straight through (Mitsuba's mask) */
+    cdl_principled_at pr; /* principled: parameters at the hit */
     cdl_frame frame; /* shading frame; n = shading normal, front side */
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
     cdl_vec3 nb;     /* shading normal before a bump/normal map (frame.n without) */

@@ -5,6 +5,7 @@
 #define CDL_MATERIAL_H
 
 #include "core/vec.h"
+#include "scene/bsdf_principled.h"
 
 typedef enum cdl_mat_type {
     CDL_MAT_DIFFUSE,         /* Lambert: kd */
@@ -18,7 +19,8 @@ typedef enum cdl_mat_type {
     CDL_MAT_COATED,          /* Mitsuba's plastic: diffuse base kd under a smooth dielectric coat of
                               * index eta reflecting ks F (a Dirac lobe); see plastic.h */
     CDL_MAT_ROUGH_COATED,    /* Mitsuba's roughplastic: the same under a rough coat (mf, alpha_x) */
-    CDL_MAT_ROUGH_DIFFUSE    /* Oren-Nayar of reflectance kd, slope deviation sigma (oren_nayar.h) */
+    CDL_MAT_ROUGH_DIFFUSE,   /* Oren-Nayar of reflectance kd, slope deviation sigma (oren_nayar.h) */
+    CDL_MAT_PRINCIPLED       /* Mitsuba 3's principled(thin): base colour kd, the rest in pr */
 } cdl_mat_type;
 
 /* Entries of the rough coat's transmittance table (Mitsuba's
@@ -75,6 +77,7 @@ typedef struct cdl_material {
     float opacity;
     int opacity_tex;  /* texture index or -1 */
     cdl_mat_maps maps; /* textured roughness, bump and normal maps */
+    cdl_principled pr; /* principled: parameters other than the base colour */
     char name[64];
 } cdl_material;
 

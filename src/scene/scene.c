@@ -600,4 +600,9 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
     if (m->masked && m->opacity_tex >= 0)
         b->opacity *= cdl_minf(1.0f, cdl_maxf(0.0f, cdl_texture_eval1(s->texs, m->opacity_tex, sf->u, sf->v)));
     cdl_scene_bsdf_maps(s, m, sf, b);
+    if (m->type == CDL_MAT_PRINCIPLED) {
+        cdl_principled_at_init(&b->pr, &m->pr, s->texs, sf->u, sf->v);
+        /* the shading tangent the vertex store keeps too, else dp/du */
+        cdl_principled_tangent(b, cdl_is_black(sf->ts) ? sf->dpdu : sf->ts);
+    }
 }
