@@ -51,6 +51,14 @@ PASSING = [
 
 # the measured reason each other scene fails (README, "Mitsuba 3 render tests")
 FAILING = {
+    "mesh_attributes/test_mesh_attributes_1_face_direct.xml":
+        "mesh_attribute textures and blendbsdf not implemented (a constant 0.5, the first bsdf): Y ratio 0.59",
+    "mesh_attributes/test_mesh_attributes_3_face_direct.xml":
+        "mesh_attribute texture (per-face colour from the PLY) not implemented: a constant 0.5, Y ratio 1.09",
+    "mesh_attributes/test_mesh_attributes_3_vertex_direct.xml":
+        "mesh_attribute texture (per-vertex colour from the PLY) not implemented: a constant 0.5, Y ratio 0.99",
+    "various_shapes/test_various_shapes_path.xml":
+        "the sdfgrid shape (a torus, instanced) is skipped; every other shape renders",
 }
 
 # participating media: not candela's (every scene of the group but this one)
