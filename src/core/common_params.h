@@ -17,6 +17,7 @@ typedef struct cdl_common_params {
     long maxdepth, threads;
     long seed;
     int sampler; /* cdl_sampler_kind */
+    int filter;  /* 0: the scene file's pixel filter, 1: the one-pixel box */
     float lights[CDL_MAX_POINT_LIGHTS][6];
     int nlights;
     double exposure;

@@ -24,7 +24,8 @@
 static int rectangle(cdl_mts_ctx *c, int line, cdl_mesh *m)
 {
     static const float p[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
-    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    /* Mitsuba's uv ((x + 1) / 2, (y + 1) / 2) in candela's convention (v flipped) */
+    static const float uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
     static const uint32_t idx[6] = {0, 1, 2, 2, 3, 0};
     int rc = cdl_mesh_alloc(m, 4, 2, 1, 1, c->file, line, c->err);
     if (rc)
