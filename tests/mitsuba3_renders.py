@@ -46,7 +46,13 @@ PASSING = [
     "floating_sphere/test_directional_direct.xml",
     "infinite_mirrors/scene_path.xml",
     "instancing/test_instancing_path.xml",
+    "orthographic_sensor/test_orthographic_path.xml",
     "participating_media/test_surf_area_light_volpath.xml",
+    "projector/test_projector_constant_direct.xml",
+    "projector/test_projector_textured_direct.xml",
+    "spot_light/test_spot_direct.xml",
+    "texture_interp/test_texture_interp_direct.xml",
+    "various_emitters/test_various_emitters_ptracer.xml",
 ]
 
 # the measured reason each other scene fails (README, "Mitsuba 3 render tests")

@@ -22,6 +22,7 @@
 #include "io/loader.h"
 #include "scene/microfacet_mts.h"
 #include "scene/plastic.h"
+#include "io/settings.h"
 #include "test_util.h"
 
 #define PI 3.14159265358979323846
@@ -698,6 +699,91 @@ static void textures_and_maps(void)
     cdl_scene_free(&s);
 }
 
+/* Issue 27: film filters (Mitsuba's default gaussian when the film names
+ * none), the orthographic sensor's frame and extent, Mitsuba's spot
+ * (linear falloff, its cone) and projector (pi scale irradiance, the
+ * texture's aspect), and emitters chosen uniformly, a mesh as one. */
+static void sensors_and_emitters(void)
+{
+    static const unsigned char ppm[] = {'P', '6', '\n', '2', ' ', '1', '\n', '2', '5', '5', '\n', 255, 0, 0, 0, 255, 0};
+    test_write(dir, "tex2x1.ppm", ppm, sizeof ppm);
+    write_file("filters.xml",
+               "<scene version=\"3.0.0\">\n"
+               "  <sensor type=\"orthographic\"><float name=\"near_clip\" value=\"0.5\"/>\n"
+               "    <transform name=\"to_world\"><scale x=\"1.5\" y=\"1.5\"/>\n"
+               "      <lookat origin=\"-5, 0, 3\" target=\"0, 0, 1\" up=\"0, 0, 1\"/></transform>\n"
+               "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"20\"/>"
+               "<integer name=\"height\" value=\"10\"/></film></sensor>\n"
+               "  <emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"30\"/>"
+               "<float name=\"beam_width\" value=\"10\"/></emitter>\n"
+               "  <emitter type=\"projector\"><float name=\"fov\" value=\"90\"/>"
+               "<float name=\"scale\" value=\"2\"/>\n"
+               "    <texture type=\"bitmap\" name=\"irradiance\"><string name=\"filename\" value=\"tex2x1.ppm\"/>"
+               "</texture></emitter>\n"
+               "  <shape type=\"rectangle\"><emitter type=\"area\"/></shape>\n"
+               "  <shape type=\"cube\"><emitter type=\"area\"/></shape>\n"
+               "</scene>\n");
+    cdl_scene s;
+    cdl_scene_settings set;
+    cdl_scene_settings_init(&set);
+    int rc = load("filters.xml", &s, &set);
+    CHECK(rc == 0, "orthographic sensor, spot, projector load");
+    if (rc)
+        return;
+    CHECK(set.has_filter && set.filter.type == CDL_FILTER_GAUSSIAN && fabsf(set.filter.radius[0] - 2.0f) < 1e-6f &&
+              fabsf(set.filter.p0 - 2.0f) < 1e-6f && set.filter.clip,
+          "a film without rfilter: Mitsuba's gaussian, stddev 0.5, radius 2");
+    CHECK(set.has_camera && set.ortho && set.ortho_near == 0.5f && set.width == 20 && set.height == 10,
+          "orthographic sensor: near clip and film");
+    CHECK(fabsf(cdl_length(set.right) - 1.5f) < 1e-5f && fabsf(cdl_length(set.up) - 1.5f) < 1e-5f &&
+              near3(unit(set.fwd), unit(cdl_v3(5, 0, -2)), 1e-5f),
+          "orthographic frame keeps the scale 1.5 and looks at the target");
+    int spot = -1, proj = -1, ntri = 0;
+    for (uint32_t i = 0; i < s.nlights; i++) {
+        spot = s.lights[i].type == CDL_LIGHT_SPOT ? (int)i : spot;
+        proj = s.lights[i].type == CDL_LIGHT_PROJECTOR ? (int)i : proj;
+        ntri += s.lights[i].type == CDL_LIGHT_TRIANGLE;
+    }
+    CHECK(spot >= 0 && s.lights[spot].spot_linear && fabsf(s.lights[spot].cutoff - (float)(PI / 6.0)) < 1e-6f &&
+              fabsf(s.lights[spot].beam - (float)(PI / 18.0)) < 1e-6f,
+          "spot: Mitsuba's linear falloff from 10 to 30 degrees");
+    /* texture 2 x 1: tan_y = tan_x / 2; L = pi scale */
+    CHECK(proj >= 0 && fabsf(s.lights[proj].tan_x - 1.0f) < 1e-5f && fabsf(s.lights[proj].tan_y - 0.5f) < 1e-5f &&
+              fabsf(s.lights[proj].L.x - 2.0f * (float)PI) < 1e-4f && s.lights[proj].tex,
+          "projector: fov 90 along x, the texture's aspect, pi scale");
+    /* uniform over 4 emitters: the rectangle's 2 and the cube's 12 triangles share theirs by area */
+    double prect = 0.0, pcube = 0.0;
+    for (uint32_t i = 0; i < s.nlights; i++)
+        if (s.lights[i].type == CDL_LIGHT_TRIANGLE)
+            *(s.lights[i].area < 2.5f && ntri == 14 && s.tri_emit[s.lights[i].prim] == s.tri_emit[s.lights[0].prim]
+                  ? &prect
+                  : &pcube) += s.light_select.pmf[i];
+    CHECK(fabs(s.light_select.pmf[spot] - 0.25) < 1e-6 && fabs(s.light_select.pmf[proj] - 0.25) < 1e-6 &&
+              fabs(prect + pcube - 0.5) < 1e-5,
+          "emitters chosen uniformly (spot %g, projector %g, meshes %g)", s.light_select.pmf[spot],
+          s.light_select.pmf[proj], prect + pcube);
+    cdl_scene_free(&s);
+    write_file("rfilters.xml",
+               "<scene version=\"3.0.0\"><sensor type=\"perspective\"><film type=\"hdrfilm\">"
+               "<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"2\"/></rfilter></film></sensor>\n"
+               "<shape type=\"rectangle\"><emitter type=\"area\"/></shape></scene>\n");
+    cdl_scene_settings_init(&set);
+    rc = load("rfilters.xml", &s, &set);
+    CHECK(rc == 0 && set.filter.type == CDL_FILTER_LANCZOS && set.filter.radius[0] == 2.0f && set.filter.p0 == 2.0f,
+          "rfilter lanczos with 2 lobes");
+    if (!rc)
+        cdl_scene_free(&s);
+    write_file("rfilterbox.xml",
+               "<scene version=\"3.0.0\"><sensor type=\"perspective\"><film type=\"hdrfilm\">"
+               "<rfilter type=\"box\"/></film></sensor>\n"
+               "<shape type=\"rectangle\"><emitter type=\"area\"/></shape></scene>\n");
+    cdl_scene_settings_init(&set);
+    rc = load("rfilterbox.xml", &s, &set);
+    CHECK(rc == 0 && set.filter.type == CDL_FILTER_BOX && !set.filter.wide, "rfilter box: the one-pixel box");
+    if (!rc)
+        cdl_scene_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     snprintf(dir, sizeof dir, "/tmp/candela-mitsuba.XXXXXX");
@@ -717,6 +803,7 @@ int main(int argc, char **argv)
     instancing();
     envmap_orientation();
     sunsky();
+    sensors_and_emitters();
     if (argc > 1)
         shared_scenes(argv[1]);
     char cmd[300];

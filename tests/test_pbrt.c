@@ -575,6 +575,52 @@ static void real_scene(const char *shared, const char *name)
     cdl_scene_free(&s);
 }
 
+/* PixelFilter (issue 27): pbrt-v3's widths and alpha, pbrt-v4's radii
+ * and sigma (its gaussian's default radius 1.5), samples not clipped. */
+static void test_filters(void)
+{
+    static const char *const files[][2] = {
+        {"f3.pbrt", "PixelFilter \"gaussian\"\n"},
+        {"f4.pbrt", "PixelFilter \"gaussian\" \"float sigma\" [ 0.25 ]\n"},
+        {"ft.pbrt", "PixelFilter \"triangle\" \"float xwidth\" [ 1 ] \"float ywidth\" [ 1.5 ]\n"},
+        {"fl.pbrt", "PixelFilter \"lanczos\"\n"}};
+    for (int i = 0; i < 4; i++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "%sWorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\"\n"
+                 "Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0]\n"
+                 "AttributeEnd\nWorldEnd\n",
+                 files[i][1]);
+        write_file(files[i][0], text);
+    }
+    cdl_scene s;
+    cdl_scene_settings set;
+    cdl_error err;
+    int rc = load("f3.pbrt", &s, &set, &err);
+    CHECK(rc == 0 && set.has_filter && set.filter.type == CDL_FILTER_GAUSSIAN && set.filter.radius[0] == 2.0f &&
+              set.filter.p0 == 2.0f && !set.filter.clip,
+          "pbrt-v3 gaussian: width 2, alpha 2, unclipped");
+    if (!rc)
+        cdl_scene_free(&s);
+    rc = load("f4.pbrt", &s, &set, &err);
+    CHECK(rc == 0 && set.filter.type == CDL_FILTER_GAUSSIAN && set.filter.radius[0] == 1.5f &&
+              fabsf(set.filter.p0 - 8.0f) < 1e-5f,
+          "pbrt-v4 gaussian: radius 1.5, sigma 0.25");
+    if (!rc)
+        cdl_scene_free(&s);
+    rc = load("ft.pbrt", &s, &set, &err);
+    CHECK(rc == 0 && set.filter.type == CDL_FILTER_TENT && set.filter.radius[0] == 1.0f &&
+              set.filter.radius[1] == 1.5f,
+          "pbrt triangle of widths 1 x 1.5");
+    if (!rc)
+        cdl_scene_free(&s);
+    rc = load("fl.pbrt", &s, &set, &err);
+    CHECK(rc == 0 && set.filter.type == CDL_FILTER_LANCZOS && set.filter.radius[0] == 4.0f && set.filter.p0 == 3.0f,
+          "pbrt-v4 lanczos: radius 4, tau 3");
+    if (!rc)
+        cdl_scene_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     const char *tmp = getenv("TMPDIR");
@@ -591,6 +637,7 @@ int main(int argc, char **argv)
     test_bilinear();
     test_spheres();
     test_materials();
+    test_filters();
     const char *shared = argc > 1 ? argv[1] : "../shared/scenes";
     real_scene(shared, "cornell-box-bitterli");
     real_scene(shared, "veach-mis");

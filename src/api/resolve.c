@@ -82,10 +82,29 @@ int cdl_settings_resolve(const cdl_settings *in, const cdl_scene *scene, cdl_set
     int w = c->res[0], h = c->res[1];
     const float *la = c->lookat;
     if (cdl_settings_given(a, "lookat"))
-        return cdl_camera_init(&opt->camera, cdl_v3(la[0], la[1], la[2]), cdl_v3(la[3], la[4], la[5]),
-                               cdl_v3(la[6], la[7], la[8]), (float)c->fov, w, h, err);
-    if (set->has_camera)
-        return cdl_camera_init_frame(&opt->camera, set->eye, set->right, set->up, set->fwd,
-                                     cdl_settings_given(a, "fov") ? (float)c->fov : set->fov, w, h, err);
-    return frame_scene(scene, c->fov, w, h, &opt->camera, err);
+        rc = cdl_camera_init(&opt->camera, cdl_v3(la[0], la[1], la[2]), cdl_v3(la[3], la[4], la[5]),
+                             cdl_v3(la[6], la[7], la[8]), (float)c->fov, w, h, err);
+    else if (set->has_camera && set->ortho)
+        rc = cdl_camera_init_ortho(&opt->camera, set->eye, set->right, set->up, set->fwd, set->ortho_half_w,
+                                   set->ortho_half_w * (float)h / (float)w, set->ortho_near, w, h, err);
+    else if (set->has_camera)
+        rc = cdl_camera_init_frame(&opt->camera, set->eye, set->right, set->up, set->fwd,
+                                   cdl_settings_given(a, "fov") ? (float)c->fov : set->fov, w, h, err);
+    else
+        rc = frame_scene(scene, c->fov, w, h, &opt->camera, err);
+    if (rc)
+        return rc;
+    if (set->has_filter && c->filter == 0) {
+        /* the methods that accumulate per pixel outside cdl_camera_sample keep the box */
+        if (!set->filter.wide || !strcmp(vt->name, "path") || !strcmp(vt->name, "bdpt") || !strcmp(vt->name, "pm"))
+            opt->camera.filter = set->filter;
+        else
+            cdl_warn(set->filter_file, set->filter_line, "%s filters with the one-pixel box: the pixel filter is ignored",
+                     vt->name);
+    }
+    /* the methods that trace eye subpaths or connect to the camera need a pinhole */
+    if (opt->camera.ortho && strcmp(vt->name, "path"))
+        return cdl_error_set(err, CDL_ERR_USAGE, set->integrator_file, set->integrator_line,
+                             "the orthographic camera is rendered by path only, not by %s", vt->name);
+    return 0;
 }

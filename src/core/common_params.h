@@ -19,6 +19,7 @@ typedef struct cdl_common_params {
     long maxdepth, threads;
     long seed;
     int sampler; /* cdl_sampler_kind */
+    int filter;  /* 0: the scene file's pixel filter, 1: the one-pixel box */
     float lights[CDL_MAX_POINT_LIGHTS][6];
     int nlights;
     char defines[CDL_MAX_DEFINES][CDL_DEFINE_LEN]; /* "name=value" for a Mitsuba file's <default>s */

@@ -101,6 +101,17 @@ int cdl_splats_add(cdl_splats *sp, uint32_t pixel, cdl_vec3 L)
     return 0;
 }
 
+int cdl_splats_add_filtered(cdl_splats *sp, const cdl_filter *f, int w, int h, float x, float y, cdl_vec3 L)
+{
+    int pix[CDL_FILTER_MAX_TAPS];
+    float wt[CDL_FILTER_MAX_TAPS];
+    int n = cdl_filter_spread(f, x, y, w, h, pix, wt);
+    for (int i = 0; i < n; i++)
+        if (cdl_splats_add(sp, (uint32_t)pix[i], cdl_scale(L, wt[i])))
+            return -1;
+    return 0;
+}
+
 void cdl_splats_free(cdl_splats *sp)
 {
     free(sp->pixel);

@@ -1,5 +1,5 @@
-/* The film: per-pixel sums of radiance samples with a one-pixel box
- * filter. A pixel is written by one thread at a time (passes split the
+/* The film: per-pixel sums of radiance samples (weighted by the pixel
+ * filter where it is wider than the one-pixel box, see filter.h). A pixel is written by one thread at a time (passes split the
  * image into tiles), so sums need no atomics and are deterministic. */
 #ifndef CDL_FILM_H
 #define CDL_FILM_H
@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "film/filter.h"
 #include "film/image.h"
 
 typedef struct cdl_film {
@@ -52,6 +53,9 @@ typedef struct cdl_splats {
 } cdl_splats;
 
 int cdl_splats_add(cdl_splats *sp, uint32_t pixel, cdl_vec3 L);
+/* A contribution at raster point (x, y) of a w x h image spread over the
+ * pixels around it by the pixel filter (cdl_filter_spread). */
+int cdl_splats_add_filtered(cdl_splats *sp, const cdl_filter *f, int w, int h, float x, float y, cdl_vec3 L);
 void cdl_splats_free(cdl_splats *sp);
 /* Adds sp to the film's splat buffer (allocating it) and empties sp.
  * Returns the number of non-finite splats dropped. */

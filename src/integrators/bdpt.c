@@ -138,11 +138,9 @@ static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint3
                     continue;
                 float x, y;
                 cdl_vec3 c = cdl_connect_camera(&cx, lvs, l0, sidx, &x, &y, rays);
-                if (!cdl_is_black(c)) {
-                    int px = (int)x, py = (int)y;
-                    cdl_splats_add(splats, (uint32_t)py * (uint32_t)st->opt.camera.width + (uint32_t)px,
-                                   cdl_scale(c, splat_scale));
-                }
+                if (!cdl_is_black(c))
+                    cdl_splats_add_filtered(splats, &st->opt.camera.filter, st->opt.camera.width,
+                                            st->opt.camera.height, x, y, cdl_scale(c, splat_scale));
                 continue;
             }
             if (sidx == 0) {
@@ -187,8 +185,9 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             cdl_sampler_start(&smp, st->opt.sampler, st->opt.seed, pix, pass);
             cdl_sampler_2d(&smp, &jx, &jy);
             cdl_vs_clear(&evs);
-            uint32_t ne = cdl_trace_eye_subpath(st->scene, cam, (float)x + jx, (float)y + jy, &st->walk,
-                                                &smp, &evs, rays);
+            float fx, fy, fw;
+            cdl_camera_sample(cam, x, y, jx, jy, &fx, &fy, &fw);
+            uint32_t ne = cdl_trace_eye_subpath(st->scene, cam, fx, fy, &st->walk, &smp, &evs, rays);
             cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
             if (!st->opt.light_paths) {
                 cdl_sampler lsmp;
@@ -219,7 +218,7 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                 if (m)
                     L = cdl_add(L, cdl_scale(Lc, 1.0f / (float)m));
             }
-            bad += (uint64_t)cdl_film_add(film, x, y, L);
+            bad += (uint64_t)cdl_film_add(film, x, y, fw == 1.0f ? L : cdl_scale(L, fw));
         }
     cdl_vs_free(&evs);
     cdl_vs_free(&lvs);

@@ -56,10 +56,11 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
  * infinite light on escape), MIS-weighted against light sampling unless
  * the last bounce was specular. */
 static cdl_vec3 emitted(const cdl_scene *s, int32_t light, cdl_vec3 o, cdl_vec3 d, float t,
-                        cdl_vec3 ng, int specular, float pdf_prev)
+                        const cdl_surface *sf, int specular, float pdf_prev)
 {
     const cdl_light *l = &s->lights[light];
-    cdl_vec3 Le = l->type == CDL_LIGHT_INFINITE ? cdl_light_env_Le(l, d) : cdl_light_Le(l, ng, cdl_neg(d));
+    cdl_vec3 Le = l->type == CDL_LIGHT_INFINITE ? cdl_light_env_Le(l, d)
+                                                : cdl_light_Le_uv(l, sf->ng, cdl_neg(d), sf->u, sf->v);
     if (specular || cdl_is_black(Le))
         return Le;
     float pdf_l = s->light_select.pmf[light] * cdl_light_pdf_li(l, o, d, t);
@@ -78,15 +79,15 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
         (*rays)++;
         if (!cdl_intersect(s, o, d, FLT_MAX, &h)) {
             if (s->env_light >= 0)
-                L = cdl_add(L, cdl_mul(beta, emitted(s, s->env_light, o, d, FLT_MAX,
-                                                     cdl_neg(d), specular, pdf_prev)));
+                L = cdl_add(L, cdl_mul(beta, emitted(s, s->env_light, o, d, FLT_MAX, NULL,
+                                                     specular, pdf_prev)));
             break;
         }
         cdl_surface sf;
         cdl_surface_at(s, &h, &sf);
         cdl_vec3 wo = cdl_neg(d);
         if (sf.light >= 0)
-            L = cdl_add(L, cdl_mul(beta, emitted(s, sf.light, o, d, h.t, sf.ng, specular, pdf_prev)));
+            L = cdl_add(L, cdl_mul(beta, emitted(s, sf.light, o, d, h.t, &sf, specular, pdf_prev)));
         if (depth >= ps->opt.maxdepth)
             break;
         cdl_bsdf b;
@@ -127,8 +128,12 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             float jx, jy;
             cdl_sampler_start(&smp, ps->opt.sampler, ps->opt.seed, (uint64_t)y * film->width + x, pass);
             cdl_sampler_2d(&smp, &jx, &jy);
-            cdl_vec3 L = radiance(ps, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy), &smp, rays);
-            bad += (uint64_t)cdl_film_add(film, x, y, L);
+            float fx, fy, fw;
+            cdl_vec3 o, d;
+            cdl_camera_sample(cam, x, y, jx, jy, &fx, &fy, &fw);
+            cdl_camera_gen(cam, fx, fy, &o, &d);
+            cdl_vec3 L = radiance(ps, o, d, &smp, rays);
+            bad += (uint64_t)cdl_film_add(film, x, y, fw == 1.0f ? L : cdl_scale(L, fw));
         }
     return bad;
 }

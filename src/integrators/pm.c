@@ -313,11 +313,12 @@ static uint64_t pm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int 
                                   (uint64_t)y * (uint64_t)film->width + (uint64_t)x, pass);
                 cdl_sampler_2d(&smp, &jx, &jy);
                 uint32_t nl = 0;
-                cdl_vec3 L = radiance(st, &w, cam->eye, cdl_camera_ray(cam, (float)x + jx, (float)y + jy),
-                                      &smp, rays, &nl);
+                float fx, fy, fw;
+                cdl_camera_sample(cam, x, y, jx, jy, &fx, &fy, &fw);
+                cdl_vec3 L = radiance(st, &w, cam->eye, cdl_camera_ray(cam, fx, fy), &smp, rays, &nl);
                 lsum += nl;
                 lpts++;
-                bad += (uint64_t)cdl_film_add(film, x, y, L);
+                bad += (uint64_t)cdl_film_add(film, x, y, fw == 1.0f ? L : cdl_scale(L, fw));
             }
         cdl_lcon_scratch_free(&w.lc);
     }

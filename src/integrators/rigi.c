@@ -176,7 +176,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
         stratum = depth < CDL_STRATA ? depth : CDL_STRATA - 1;
         w->plen[pixel] = (float)(depth + 1);
         if (sf.light >= 0 && (depth == 0 || !st->clamped || prev_delta)) {
-            cdl_vec3 e = cdl_mul(beta, cdl_light_Le(&s->lights[sf.light], sf.ng, wo));
+            cdl_vec3 e = cdl_mul(beta, cdl_light_Le_uv(&s->lights[sf.light], sf.ng, wo, sf.u, sf.v));
             L = cdl_add(L, e);
             w->strata[pixel][stratum] = cdl_add(w->strata[pixel][stratum], e);
         }

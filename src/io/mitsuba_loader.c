@@ -23,6 +23,72 @@
 
 /* ---- sensor, film, sampler, integrator ---- */
 
+/* A film's <rfilter>, or Mitsuba's default (a Gaussian of stddev 0.5)
+ * when k is NULL. Mitsuba samples only inside the image: clip is on. */
+static int rfilter(cdl_mts_ctx *c, cdl_xml_node *k, int line)
+{
+    char type[64] = "gaussian";
+    int rc;
+    cdl_filter *f = &c->set->filter;
+    double p0 = 0.0, p1 = 0.0, r = 0.5;
+    if (k) {
+        k->used = 1;
+        if ((rc = cdl_mts_type(c, k, type, sizeof type)))
+            return rc;
+        line = k->line;
+    }
+    cdl_filter_type t;
+    if (!strcmp(type, "box")) {
+        t = CDL_FILTER_BOX;
+    } else if (!strcmp(type, "tent")) {
+        t = CDL_FILTER_TENT;
+        if (k && (rc = cdl_mts_float(c, k, "radius", 1.0, &r)))
+            return rc;
+        r = k ? r : 1.0;
+    } else if (!strcmp(type, "gaussian")) {
+        double sd = 0.5;
+        if (k && (rc = cdl_mts_float(c, k, "stddev", 0.5, &sd)))
+            return rc;
+        if (!(sd > 0.0 && sd <= 4.0))
+            return cdl_mts_error(c, line, "rfilter gaussian: stddev %g must be in (0, 4]", sd);
+        t = CDL_FILTER_GAUSSIAN;
+        r = 4.0 * sd; /* cut off after 4 standard deviations */
+        p0 = 1.0 / (2.0 * sd * sd);
+    } else if (!strcmp(type, "mitchell") || !strcmp(type, "catmullrom")) {
+        t = CDL_FILTER_MITCHELL;
+        r = 2.0;
+        p0 = type[0] == 'c' ? 0.0 : 1.0 / 3.0;
+        p1 = type[0] == 'c' ? 0.5 : 1.0 / 3.0;
+        if (k && type[0] == 'm' && ((rc = cdl_mts_float(c, k, "B", p0, &p0)) || (rc = cdl_mts_float(c, k, "C", p1, &p1))))
+            return rc;
+        if (!(fabs(p0) <= 10.0 && fabs(p1) <= 10.0))
+            return cdl_mts_error(c, line, "rfilter mitchell: B and C must be in [-10, 10]");
+    } else if (!strcmp(type, "lanczos")) {
+        long lobes = 3;
+        if (k && (rc = cdl_mts_int(c, k, "lobes", 3, &lobes)))
+            return rc;
+        if (lobes < 1 || lobes > 16)
+            return cdl_mts_error(c, line, "rfilter lanczos: lobes %ld must be in 1..16", lobes);
+        t = CDL_FILTER_LANCZOS;
+        r = p0 = (double)lobes;
+    } else {
+        cdl_mts_warn(c, line, "rfilter \"%s\" is not supported: the box is used", type);
+        for (int i = 0; k && i < k->nkids; i++)
+            k->kids[i].used = 1;
+        return 0;
+    }
+    if (!(r > 0.0 && r <= 16.0))
+        return cdl_mts_error(c, line, "rfilter %s: radius %g must be in (0, 16] pixels", type, r);
+    if (k)
+        cdl_mts_warn_unused(c, k, "rfilter");
+    if (cdl_filter_init(f, t, (float)r, (float)r, (float)p0, (float)p1, 1))
+        return cdl_mts_error(c, line, "rfilter %s: its weights do not integrate to a positive value", type);
+    c->set->has_filter = 1;
+    snprintf(c->set->filter_file, sizeof c->set->filter_file, "%s", c->file);
+    c->set->filter_line = line;
+    return 0;
+}
+
 static int film(cdl_mts_ctx *c, cdl_xml_node *f, long *w, long *h)
 {
     char type[64];
@@ -37,11 +103,12 @@ static int film(cdl_mts_ctx *c, cdl_xml_node *f, long *w, long *h)
         return rc;
     if (*w < 1 || *h < 1 || *w > 65536 || *h > 65536)
         return cdl_mts_error(c, f->line, "film size %ld x %ld must be in 1..65536", *w, *h);
+    cdl_xml_node *rf = NULL;
     for (int i = 0; i < f->nkids; i++) {
         cdl_xml_node *k = &f->kids[i];
         const char *pn = cdl_xml_attr_get(k, "name");
         if (!strcmp(k->name, "rfilter")) {
-            k->used = 1; /* candela's pixel filter is a box */
+            rf = k;
         } else if (pn && (cdl_mts_same_name(pn, "crop_offset_x") || cdl_mts_same_name(pn, "crop_width") ||
                           cdl_mts_same_name(pn, "crop_offset_y") || cdl_mts_same_name(pn, "crop_height"))) {
             cdl_mts_warn(c, k->line, "film crop ignored: the whole image is rendered");
@@ -50,6 +117,8 @@ static int film(cdl_mts_ctx *c, cdl_xml_node *f, long *w, long *h)
             k->used = 1; /* file format, pixel format, banner, ...: output details */
         }
     }
+    if ((rc = rfilter(c, rf, f->line)))
+        return rc;
     cdl_mts_warn_unused(c, f, "film");
     return 0;
 }
@@ -75,6 +144,43 @@ static int shorter_axis_fov(cdl_mts_ctx *c, int line, double fov, const char *ax
     return 0;
 }
 
+/* Mitsuba's orthographic sensor: the to_world image of [-1, 1] x
+ * [-1/aspect, 1/aspect] on the plane z = near_clip, looking down +z. */
+static int ortho_sensor(cdl_mts_ctx *c, cdl_xml_node *n, long w, long h)
+{
+    double near, far;
+    cdl_mat4 m;
+    int rc;
+    if ((rc = cdl_mts_float(c, n, "near_clip", 0.01, &near)) || (rc = cdl_mts_float(c, n, "far_clip", 1e4, &far)) ||
+        (rc = cdl_mts_transform(c, n, "to_world", &m)))
+        return rc;
+    if (!(near >= 0.0 && near < far && far <= 1e30))
+        return cdl_mts_error(c, n->line, "sensor near_clip %g and far_clip %g must satisfy 0 <= near < far", near, far);
+    for (int i = 0; i < n->nkids; i++) {
+        const char *pn = cdl_xml_attr_get(&n->kids[i], "name");
+        if (pn && (cdl_mts_same_name(pn, "shutter_open") || cdl_mts_same_name(pn, "shutter_close") ||
+                   cdl_mts_same_name(pn, "srf")))
+            n->kids[i].used = 1;
+    }
+    cdl_mts_warn_unused(c, n, "sensor");
+    cdl_scene_settings *set = c->set;
+    set->has_camera = 1;
+    set->ortho = 1;
+    /* the frame keeps to_world's scale: it sizes the image plane */
+    set->eye = cdl_mat4_point3(&m, cdl_v3(0, 0, 0));
+    set->right = cdl_scale(cdl_mat4_vector3(&m, cdl_v3(1, 0, 0)), -1.0f);
+    set->up = cdl_mat4_vector3(&m, cdl_v3(0, 1, 0));
+    set->fwd = cdl_mat4_vector3(&m, cdl_v3(0, 0, 1));
+    set->ortho_half_w = 1.0f;
+    set->ortho_near = (float)near;
+    set->fov = 90.0f;
+    set->width = (int)w;
+    set->height = (int)h;
+    if (!(cdl_length(set->fwd) > 0.0f) || !(cdl_length(set->up) > 0.0f) || !(cdl_length(set->right) > 0.0f))
+        return cdl_mts_error(c, n->line, "sensor to_world is singular");
+    return 0;
+}
+
 static int sensor(cdl_mts_ctx *c, cdl_xml_node *n)
 {
     char type[64], axis[32];
@@ -86,8 +192,8 @@ static int sensor(cdl_mts_ctx *c, cdl_xml_node *n)
         return 0;
     }
     c->saw_sensor = 1;
-    int thin = !strcmp(type, "thinlens");
-    if (strcmp(type, "perspective") && !thin) {
+    int thin = !strcmp(type, "thinlens"), ortho = !strcmp(type, "orthographic");
+    if (strcmp(type, "perspective") && !thin && !ortho) {
         cdl_mts_warn(c, n->line, "sensor \"%s\" is not supported (candela's default camera is used)", type);
         return 0;
     }
@@ -96,9 +202,11 @@ static int sensor(cdl_mts_ctx *c, cdl_xml_node *n)
     long w = 768, h = 576, spp;
     double fov;
     cdl_mat4 m;
+    int saw_film = 0;
     for (int i = 0; i < n->nkids && !rc; i++) {
         cdl_xml_node *k = &n->kids[i];
         if (!strcmp(k->name, "film")) {
+            saw_film = 1;
             rc = film(c, k, &w, &h);
         } else if (!strcmp(k->name, "sampler")) {
             k->used = 1;
@@ -111,8 +219,12 @@ static int sensor(cdl_mts_ctx *c, cdl_xml_node *n)
                 k->kids[j].used = 1; /* seeds, dimensions: candela's own sampler */
         }
     }
+    if (!rc && !saw_film) /* Mitsuba's default film, with its default filter */
+        rc = rfilter(c, NULL, n->line);
     if (rc)
         return rc;
+    if (ortho)
+        return ortho_sensor(c, n, w, h);
     if ((rc = cdl_mts_float(c, n, "fov", 0.0, &fov)) || (rc = cdl_mts_string(c, n, "fov_axis", "x", axis, sizeof axis)) ||
         (rc = cdl_mts_transform(c, n, "to_world", &m)))
         return rc;
@@ -319,6 +431,10 @@ int cdl_load_mitsuba(cdl_scene *s, const char *path, const char (*defs)[CDL_DEFI
     set->width = 768;
     set->height = 576;
     set->spp = 4;
+    /* Mitsuba picks an emitter uniformly for next-event estimation: power
+     * would all but starve a spot beside a constant environment, whose
+     * power through the scene's bounds dwarfs it */
+    s->light_select_uniform = 1;
     int rc = 0;
     for (int i = 0; i < ndefs && !rc; i++) {
         const char *eq = strchr(defs[i], '=');
@@ -344,6 +460,7 @@ int cdl_load_mitsuba(cdl_scene *s, const char *path, const char (*defs)[CDL_DEFI
         double f;
         shorter_axis_fov(c, 0, 45.0, "x", 768, 576, &f);
         set->fov = (float)f;
+        rc = rfilter(c, NULL, 0);
     }
     if (!rc && s->ntris == 0 && s->nspheres == 0 && s->ninsts == 0)
         rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0,

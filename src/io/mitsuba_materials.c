@@ -580,13 +580,18 @@ int cdl_mts_area(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *emit)
     n->used = 1;
     if (strcmp(type, "area"))
         return cdl_mts_error(c, n->line, "emitter \"%s\" inside a <shape>: only \"area\" belongs there", type);
-    if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &L, NULL)) ||
+    int tex;
+    if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &L, &tex)) ||
         (rc = check_emission(c, n->line, "area radiance", L)))
         return rc;
     cdl_mts_prop(c, n, "sampling_weight");
     cdl_mts_warn_unused(c, n, "emitter \"area\"");
-    /* Mitsuba's area emitters shine from the front face only */
-    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_emitter(c->s, L, 0, emit, c->err));
+    /* Mitsuba's area emitters shine from the front face only; a bitmap
+     * radiance is looked up at the surface's uv as a reflectance is */
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_emitter(c->s, L, 0, emit, c->err))))
+        return rc;
+    c->s->emitters[*emit].tex = tex;
+    return 0;
 }
 
 int cdl_mts_latlong_light(cdl_mts_ctx *c, int line, const cdl_vec3 axes[3], const char *path, float scale, int w,
@@ -640,6 +645,116 @@ static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
     return cdl_mts_latlong_light(c, n->line, axes, path, (float)scale, 0, 0, NULL);
 }
 
+/* The unit frame of a spot or projector: to_world's x, y and z axes. */
+static int light_frame(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m, cdl_light *l)
+{
+    l->p = cdl_mat4_point3(m, cdl_v3(0, 0, 0));
+    cdl_vec3 x = cdl_mat4_vector3(m, cdl_v3(1, 0, 0)), y = cdl_mat4_vector3(m, cdl_v3(0, 1, 0)),
+             z = cdl_mat4_vector3(m, cdl_v3(0, 0, 1));
+    float lx = cdl_length(x), ly = cdl_length(y), lz = cdl_length(z);
+    if (!(lx > 0.0f && ly > 0.0f && lz > 0.0f) || !isfinite(lx + ly + lz))
+        return cdl_mts_error(c, n->line, "emitter to_world is singular");
+    l->ax = cdl_scale(x, 1.0f / lx);
+    l->ay = cdl_scale(y, 1.0f / ly);
+    l->n = cdl_scale(z, 1.0f / lz);
+    if (fabsf(cdl_dot(l->ax, l->ay)) > 1e-3f || fabsf(cdl_dot(l->ax, l->n)) > 1e-3f ||
+        fabsf(cdl_dot(l->ay, l->n)) > 1e-3f)
+        return cdl_mts_error(c, n->line, "emitter to_world must keep right angles (rotations, translations, scales)");
+    return 0;
+}
+
+/* Mitsuba 3's spot: intensity linear in the angle between beam_width and
+ * cutoff_angle, times an optional texture projected over the cutoff cone. */
+static int spot(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
+{
+    double cut, beam;
+    cdl_light l;
+    cdl_vec3 k;
+    int rc;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_SPOT;
+    l.spot_linear = 1;
+    if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &l.L, NULL)) ||
+        (rc = check_emission(c, n->line, "spot intensity", l.L)) ||
+        (rc = cdl_mts_float(c, n, "cutoff_angle", 20.0, &cut)) ||
+        (rc = cdl_mts_float(c, n, "beam_width", cut * 0.75, &beam)) ||
+        (rc = color(c, n, "texture", cdl_v3(1, 1, 1), &k, &l.tex_id)))
+        return rc;
+    if (!(cut > 0.0 && cut < 90.0))
+        return cdl_mts_error(c, n->line, "spot cutoff_angle %g must be in (0, 90) degrees", cut);
+    if (!(beam >= 0.0 && beam <= cut))
+        return cdl_mts_error(c, n->line, "spot beam_width %g must be in [0, cutoff_angle = %g]", beam, cut);
+    l.L = cdl_mul(l.L, k); /* a constant texture scales the intensity */
+    if ((rc = light_frame(c, n, m, &l)))
+        return rc;
+    l.cutoff = (float)(cut * CDL_PI / 180.0);
+    l.beam = (float)(beam * CDL_PI / 180.0);
+    l.cos_total = cosf(l.cutoff);
+    l.cos_falloff = cosf(l.beam);
+    l.tan_x = l.tan_y = tanf(l.cutoff);
+    cdl_mts_warn_unused(c, n, "emitter \"spot\"");
+    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_light(c->s, &l, c->err));
+}
+
+/* Mitsuba 3's projector: a perspective camera run backwards; the
+ * irradiance (an image or a constant) at distance 1 along its axis, times
+ * pi scale (Mitsuba's normalization: a white diffuse plane at distance 1
+ * then has radiance irradiance * scale). */
+static int projector(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
+{
+    double scale, fov;
+    char axis[32], fl[32];
+    cdl_light l;
+    cdl_vec3 E;
+    int rc;
+    memset(&l, 0, sizeof l);
+    l.type = CDL_LIGHT_PROJECTOR;
+    if ((rc = color(c, n, "irradiance", cdl_v3(1, 1, 1), &E, &l.tex_id)) ||
+        (rc = check_emission(c, n->line, "projector irradiance", E)) ||
+        (rc = cdl_mts_float(c, n, "scale", 1.0, &scale)) || (rc = cdl_mts_float(c, n, "fov", 0.0, &fov)) ||
+        (rc = cdl_mts_string(c, n, "fov_axis", "x", axis, sizeof axis)) ||
+        (rc = cdl_mts_string(c, n, "focal_length", "50mm", fl, sizeof fl)))
+        return rc;
+    if (!cdl_mts_prop(c, n, "irradiance"))
+        return cdl_mts_error(c, n->line, "emitter \"projector\" needs an \"irradiance\"");
+    if (!(scale >= 0.0 && scale <= 1e12))
+        return cdl_mts_error(c, n->line, "projector scale %g must be in [0, 1e12]", scale);
+    /* the image's aspect is the texture's (a constant: square) */
+    double aspect = 1.0;
+    if (l.tex_id >= 0)
+        aspect = (double)c->s->texs[l.tex_id].w / (double)c->s->texs[l.tex_id].h;
+    if (!cdl_mts_prop(c, n, "fov")) {
+        double f = strtod(fl, NULL);
+        if (!(f > 0.0 && f < 1e6))
+            return cdl_mts_error(c, n->line, "focal_length \"%s\" must be a positive length in mm", fl);
+        fov = 2.0 * atan(sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * f)) * 180.0 / CDL_PI;
+        snprintf(axis, sizeof axis, "diagonal");
+    }
+    if (!(fov > 0.0 && fov < 180.0))
+        return cdl_mts_error(c, n->line, "projector fov %g must be in (0, 180) degrees", fov);
+    double along;
+    if (!strcmp(axis, "x"))
+        along = aspect;
+    else if (!strcmp(axis, "y"))
+        along = 1.0;
+    else if (!strcmp(axis, "diagonal"))
+        along = sqrt(1.0 + aspect * aspect);
+    else if (!strcmp(axis, "smaller"))
+        along = aspect < 1.0 ? aspect : 1.0;
+    else if (!strcmp(axis, "larger"))
+        along = aspect > 1.0 ? aspect : 1.0;
+    else
+        return cdl_mts_error(c, n->line, "fov_axis \"%s\" must be x, y, diagonal, smaller or larger", axis);
+    if ((rc = light_frame(c, n, m, &l)))
+        return rc;
+    double tx = tan(fov * CDL_PI / 360.0) * aspect / along;
+    l.tan_x = (float)tx;
+    l.tan_y = (float)(tx / aspect);
+    l.L = cdl_scale(E, (float)(CDL_PI * scale));
+    cdl_mts_warn_unused(c, n, "emitter \"projector\"");
+    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_light(c->s, &l, c->err));
+}
+
 int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
 {
     char type[64];
@@ -662,28 +777,10 @@ int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
         cdl_mts_warn_unused(c, n, "emitter \"point\"");
         return cdl_mts_scene_rc(c, n->line, cdl_scene_add_point_light(c->s, p, v, c->err));
     }
-    if (!strcmp(type, "spot")) {
-        double cut, beam;
-        if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &v, NULL)) ||
-            (rc = check_emission(c, n->line, "spot intensity", v)) ||
-            (rc = cdl_mts_float(c, n, "cutoff_angle", 20.0, &cut)) ||
-            (rc = cdl_mts_float(c, n, "beam_width", cut * 0.75, &beam)))
-            return rc;
-        if (!(cut > 0.0 && cut <= 90.0))
-            return cdl_mts_error(c, n->line, "spot cutoff_angle %g must be in (0, 90] degrees", cut);
-        if (!(beam >= 0.0 && beam <= cut))
-            return cdl_mts_error(c, n->line, "spot beam_width %g must be in [0, cutoff_angle = %g]", beam, cut);
-        if (cdl_mts_prop(c, n, "texture"))
-            cdl_mts_warn(c, n->line, "spot texture ignored");
-        p = cdl_mat4_point3(&m, cdl_v3(0, 0, 0));
-        d = cdl_mat4_vector3(&m, cdl_v3(0, 0, 1));
-        if (!(cdl_length(d) > 0.0f))
-            return cdl_mts_error(c, n->line, "spot to_world is singular");
-        cdl_mts_warn_unused(c, n, "emitter \"spot\"");
-        /* Mitsuba's falloff runs from beam_width to cutoff_angle, pbrt's over conedelta */
-        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_spot_light(c->s, p, d, v, (float)cut, (float)(cut - beam),
-                                                                     c->err));
-    }
+    if (!strcmp(type, "spot"))
+        return spot(c, n, &m);
+    if (!strcmp(type, "projector"))
+        return projector(c, n, &m);
     if (!strcmp(type, "directional")) {
         if ((rc = color(c, n, "irradiance", cdl_v3(1, 1, 1), &v, NULL)) ||
             (rc = check_emission(c, n->line, "directional irradiance", v)) ||

@@ -9,6 +9,7 @@ void cdl_scene_settings_init(cdl_scene_settings *set)
 {
     memset(set, 0, sizeof *set);
     set->maxdepth = -1;
+    cdl_filter_box(&set->filter);
 }
 
 void cdl_scene_settings_param(cdl_scene_settings *set, const char *name, const char *value, const char *file,

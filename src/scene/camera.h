@@ -1,16 +1,23 @@
-/* Pinhole perspective camera. Raster (0,0) is the top-left corner of the
- * image; +x of the raster is the camera's right = forward x up. */
+/* Pinhole perspective or orthographic camera, with its pixel filter.
+ * Raster (0,0) is the top-left corner of the image; +x of the raster is
+ * the camera's right = forward x up. */
 #ifndef CDL_CAMERA_H
 #define CDL_CAMERA_H
 
 #include "core/error.h"
 #include "core/vec.h"
+#include "film/filter.h"
 
 typedef struct cdl_camera {
     cdl_vec3 eye, fwd, right, up; /* world images of camera z, x, y (orthonormal for lookat) */
     float tan_half;               /* tan(vertical fov / 2) */
     float aspect;                 /* width / height */
     int width, height;
+    /* orthographic: rays leave eye + sx right + sy up + near fwd along fwd,
+     * sx in [-half_w, half_w] across the image, sy in [-half_h, half_h] */
+    int ortho;
+    float half_w, half_h, near;
+    cdl_filter filter; /* the one-pixel box unless a scene file asks otherwise */
 } cdl_camera;
 
 /* fov_deg is the vertical field of view; fails on degenerate frames. */
@@ -24,7 +31,13 @@ int cdl_camera_init(cdl_camera *c, cdl_vec3 eye, cdl_vec3 target, cdl_vec3 up,
 int cdl_camera_init_frame(cdl_camera *c, cdl_vec3 eye, cdl_vec3 right, cdl_vec3 up, cdl_vec3 fwd,
                           float fov_deg, int width, int height, cdl_error *err);
 
-/* Unit direction through raster position (x, y) in pixels. */
+/* Orthographic (Mitsuba's orthographic sensor): the frame as above, the
+ * image spanning [-half_w, half_w] x [-half_h, half_h] of right and up,
+ * rays starting at distance near along fwd. */
+int cdl_camera_init_ortho(cdl_camera *c, cdl_vec3 eye, cdl_vec3 right, cdl_vec3 up, cdl_vec3 fwd, float half_w,
+                          float half_h, float near, int width, int height, cdl_error *err);
+
+/* Unit direction through raster position (x, y) in pixels (pinhole). */
 static inline cdl_vec3 cdl_camera_ray(const cdl_camera *c, float x, float y)
 {
     float sx = (2.0f * x / (float)c->width - 1.0f) * c->tan_half * c->aspect;
@@ -32,10 +45,35 @@ static inline cdl_vec3 cdl_camera_ray(const cdl_camera *c, float x, float y)
     return cdl_normalize(cdl_add(c->fwd, cdl_add(cdl_scale(c->right, sx), cdl_scale(c->up, sy))));
 }
 
+/* The ray through raster position (x, y): origin and unit direction. */
+static inline void cdl_camera_gen(const cdl_camera *c, float x, float y, cdl_vec3 *o, cdl_vec3 *d)
+{
+    if (!c->ortho) {
+        *o = c->eye;
+        *d = cdl_camera_ray(c, x, y);
+        return;
+    }
+    float sx = (2.0f * x / (float)c->width - 1.0f) * c->half_w;
+    float sy = (1.0f - 2.0f * y / (float)c->height) * c->half_h;
+    *o = cdl_add(cdl_madd(c->eye, c->fwd, c->near), cdl_add(cdl_scale(c->right, sx), cdl_scale(c->up, sy)));
+    *d = cdl_normalize(c->fwd);
+}
+
+/* A camera sample of pixel (px, py) from two uniform numbers: its raster
+ * position and the weight of its radiance (the pixel filter's). */
+static inline void cdl_camera_sample(const cdl_camera *c, int px, int py, float u1, float u2, float *x, float *y,
+                                     float *weight)
+{
+    cdl_filter_sample(&c->filter, px, py, c->width, c->height, u1, u2, x, y, weight);
+}
+
 /* Raster position where direction d (from the eye) lands; 0 when it
- * points outside the image or backwards. Used by light tracing. */
+ * points outside the image or backwards (always for the orthographic
+ * camera, which no point can be connected to). Used by light tracing. */
 static inline int cdl_camera_raster(const cdl_camera *c, cdl_vec3 d, float *x, float *y)
 {
+    if (c->ortho)
+        return 0;
     float z = cdl_dot(d, c->fwd);
     if (z <= 0.0f)
         return 0;

@@ -4,13 +4,27 @@
 
 #include "core/sampling.h"
 #include "scene/envmap.h"
+#include "scene/texture.h"
 
-/* A uniform point on a triangle light. */
-static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2)
+/* A uniform point on a triangle light, and its radiance there. */
+static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2, cdl_vec3 *L)
 {
     float b1, b2;
     cdl_sample_triangle(u1, u2, &b1, &b2);
+    *L = l->L;
+    if (l->tex) {
+        float u = l->uv[0] + b1 * (l->uv[2] - l->uv[0]) + b2 * (l->uv[4] - l->uv[0]);
+        float v = l->uv[1] + b1 * (l->uv[3] - l->uv[1]) + b2 * (l->uv[5] - l->uv[1]);
+        *L = cdl_mul(*L, cdl_texture_lookup(l->tex, u, v));
+    }
     return cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+}
+
+/* A texture projected by a spot or projector at Mitsuba's uv, whose v = 0
+ * is the image's top row (candela's lookup has v = 0 at the bottom). */
+static cdl_vec3 projected(const cdl_light *l, float u, float v)
+{
+    return cdl_texture_lookup(l->tex, u, 1.0f - v);
 }
 
 /* A cosine-distributed emission direction about e->n (area lights);
@@ -26,15 +40,67 @@ static int emit_cosine(cdl_light_emit *e, float u3, float u4, float face_prob)
     return 1;
 }
 
-/* pbrt-v3's spot falloff: smooth fourth power between the two cones. */
+/* pbrt-v3's spot falloff: smooth fourth power between the two cones;
+ * Mitsuba's: linear in the angle. */
 static float spot_falloff(const cdl_light *l, float cos_t)
 {
+    if (l->spot_linear) {
+        if (!(cos_t > l->cos_total))
+            return 0.0f;
+        if (cos_t >= l->cos_falloff || !(l->cutoff > l->beam))
+            return 1.0f;
+        float a = acosf(cdl_minf(cos_t, 1.0f));
+        return fminf(fmaxf((l->cutoff - a) / (l->cutoff - l->beam), 0.0f), 1.0f);
+    }
     if (cos_t < l->cos_total)
         return 0.0f;
     if (cos_t >= l->cos_falloff)
         return 1.0f;
     float d = (cos_t - l->cos_total) / (l->cos_falloff - l->cos_total);
     return (d * d) * (d * d);
+}
+
+cdl_vec3 cdl_light_I_factor(const cdl_light *l, cdl_vec3 w)
+{
+    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    float c = cdl_dot(w, l->n);
+    if (l->type == CDL_LIGHT_SPOT) {
+        float f = spot_falloff(l, c);
+        if (!(f > 0.0f))
+            return zero;
+        if (!l->tex)
+            return cdl_v3(f, f, f);
+        /* Mitsuba's spot uv: u grows along +x (the light's left) */
+        float u = 0.5f + 0.5f * cdl_dot(w, l->ax) / (c * l->tan_x);
+        float v = 0.5f + 0.5f * cdl_dot(w, l->ay) / (c * l->tan_y);
+        return cdl_scale(projected(l, u, v), f);
+    }
+    if (l->type == CDL_LIGHT_PROJECTOR) {
+        if (!(c > 0.0f))
+            return zero;
+        /* a perspective camera's uv (u grows to the image's right, v down):
+         * the irradiance at distance 1, as intensity over cos^3 */
+        float u = 0.5f - 0.5f * cdl_dot(w, l->ax) / (c * l->tan_x);
+        float v = 0.5f - 0.5f * cdl_dot(w, l->ay) / (c * l->tan_y);
+        if (!(u >= 0.0f && u <= 1.0f && v >= 0.0f && v <= 1.0f))
+            return zero;
+        float k = 1.0f / (c * c * c);
+        return l->tex ? cdl_scale(projected(l, u, v), k) : cdl_v3(k, k, k);
+    }
+    return cdl_v3(1.0f, 1.0f, 1.0f);
+}
+
+float cdl_light_pdf_emit_dir(const cdl_light *l, cdl_vec3 w)
+{
+    float c = cdl_dot(w, l->n);
+    if (l->type == CDL_LIGHT_SPOT)
+        return c >= l->cos_total ? 1.0f / (2.0f * CDL_PI * (1.0f - l->cos_total)) : 0.0f;
+    if (l->type == CDL_LIGHT_PROJECTOR) {
+        if (!(c > 0.0f) || fabsf(cdl_dot(w, l->ax)) > c * l->tan_x || fabsf(cdl_dot(w, l->ay)) > c * l->tan_y)
+            return 0.0f;
+        return 1.0f / (4.0f * l->tan_x * l->tan_y * c * c * c);
+    }
+    return 0.0f;
 }
 
 /* 1 - cos(theta_max) of the cone a sphere subtends, sin^2 theta_max given:
@@ -99,7 +165,8 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
 {
     switch (l->type) {
     case CDL_LIGHT_POINT:
-    case CDL_LIGHT_SPOT: {
+    case CDL_LIGHT_SPOT:
+    case CDL_LIGHT_PROJECTOR: {
         cdl_vec3 d = cdl_sub(l->p, ref);
         float d2 = cdl_dot(d, d);
         if (!(d2 > 0.0f))
@@ -107,11 +174,10 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
         s->dist = sqrtf(d2);
         s->wi = cdl_scale(d, 1.0f / s->dist);
         s->p = l->p;
-        float fall = l->type == CDL_LIGHT_SPOT ? spot_falloff(l, -cdl_dot(s->wi, l->n)) : 1.0f;
-        s->Li = cdl_scale(l->L, fall / d2);
+        s->Li = cdl_scale(cdl_mul(l->L, cdl_light_I_factor(l, cdl_neg(s->wi))), 1.0f / d2);
         s->pdf = 1.0f;
         s->delta = 1;
-        return fall > 0.0f;
+        return !cdl_is_black(s->Li);
     }
     case CDL_LIGHT_DISTANT:
         s->wi = cdl_neg(l->n);
@@ -140,7 +206,8 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    s->p = triangle_point(l, u1, u2);
+    cdl_vec3 Le;
+    s->p = triangle_point(l, u1, u2, &Le);
     cdl_vec3 d = cdl_sub(s->p, ref);
     float d2 = cdl_dot(d, d);
     if (!(d2 > 0.0f))
@@ -152,7 +219,7 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
         cos_l = fabsf(cos_l);
     if (cos_l <= 0.0f)
         return 0; /* receiver behind the emitting face */
-    s->Li = l->L;
+    s->Li = Le;
     s->pdf = d2 / (cos_l * l->area);
     s->delta = 0;
     return 1;
@@ -192,12 +259,19 @@ cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo)
     return front ? l->L : cdl_v3(0.0f, 0.0f, 0.0f);
 }
 
+cdl_vec3 cdl_light_Le_uv(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo, float u, float v)
+{
+    cdl_vec3 L = cdl_light_Le(l, ng, wo);
+    return l->tex && !cdl_is_black(L) ? cdl_mul(L, cdl_texture_lookup(l->tex, u, v)) : L;
+}
+
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,
                         cdl_light_emit *e)
 {
     switch (l->type) {
     case CDL_LIGHT_POINT:
     case CDL_LIGHT_SPOT:
+    case CDL_LIGHT_PROJECTOR:
         e->p = l->p;
         e->n = cdl_v3(0.0f, 0.0f, 0.0f);
         e->pdf_pos = 1.0f;
@@ -205,7 +279,7 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
             e->d = cdl_sample_uniform_sphere(u3, u4);
             e->pdf_dir = 0.25f * CDL_INV_PI;
             e->Le = l->L;
-        } else {
+        } else if (l->type == CDL_LIGHT_SPOT) {
             /* uniform in the outer cone */
             float cos_t = 1.0f - u3 * (1.0f - l->cos_total);
             float sin_t = sqrtf(cdl_maxf(0.0f, 1.0f - cos_t * cos_t));
@@ -213,7 +287,16 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
             cdl_frame f = cdl_frame_from(l->n);
             e->d = cdl_to_world(&f, cdl_v3(sin_t * cosf(phi), sin_t * sinf(phi), cos_t));
             e->pdf_dir = 1.0f / (2.0f * CDL_PI * (1.0f - l->cos_total));
-            e->Le = cdl_scale(l->L, spot_falloff(l, cos_t));
+            e->Le = l->tex || l->spot_linear ? cdl_mul(l->L, cdl_light_I_factor(l, e->d))
+                                             : cdl_scale(l->L, spot_falloff(l, cos_t));
+        } else {
+            /* uniform on the image at distance 1 */
+            cdl_vec3 q = cdl_add(cdl_scale(l->ax, (2.0f * u3 - 1.0f) * l->tan_x),
+                                 cdl_scale(l->ay, (2.0f * u4 - 1.0f) * l->tan_y));
+            e->d = cdl_normalize(cdl_add(l->n, q));
+            e->pdf_dir = cdl_light_pdf_emit_dir(l, e->d);
+            e->Le = cdl_mul(l->L, cdl_light_I_factor(l, e->d));
+            return e->pdf_dir > 0.0f;
         }
         return 1;
     case CDL_LIGHT_DISTANT:
@@ -254,7 +337,7 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    e->p = triangle_point(l, u1, u2);
+    e->p = triangle_point(l, u1, u2, &e->Le);
     e->n = l->n;
     float pick = u3;
     if (l->twosided) {
@@ -262,7 +345,6 @@ int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float 
         pick = u3 < 0.5f ? 2.0f * u3 : 2.0f * u3 - 1.0f;
         e->n = cdl_scale(l->n, u3 < 0.5f ? 1.0f : -1.0f);
     }
-    e->Le = l->L;
     e->pdf_pos = 1.0f / l->area;
     return emit_cosine(e, pick, u4, l->twosided ? 0.5f : 1.0f);
 }
@@ -272,8 +354,20 @@ cdl_vec3 cdl_light_power(const cdl_light *l)
     switch (l->type) {
     case CDL_LIGHT_POINT:
         return cdl_scale(l->L, 4.0f * CDL_PI);
-    case CDL_LIGHT_SPOT:
-        return cdl_scale(l->L, 2.0f * CDL_PI * (1.0f - 0.5f * (l->cos_falloff + l->cos_total)));
+    case CDL_LIGHT_SPOT: {
+        float omega = 2.0f * CDL_PI * (1.0f - 0.5f * (l->cos_falloff + l->cos_total));
+        if (l->spot_linear) { /* 2 pi int falloff sin: midpoints */
+            omega = 0.0f;
+            for (int i = 0; i < 64; i++) {
+                float t = (i + 0.5f) / 64.0f * l->cutoff;
+                omega += spot_falloff(l, cosf(t)) * sinf(t);
+            }
+            omega *= 2.0f * CDL_PI * l->cutoff / 64.0f;
+        }
+        return cdl_scale(l->tex ? cdl_mul(l->L, l->tex_mean) : l->L, omega);
+    }
+    case CDL_LIGHT_PROJECTOR: /* int E / cos^3 dw = int E over the image at distance 1 */
+        return cdl_scale(l->tex ? cdl_mul(l->L, l->tex_mean) : l->L, 4.0f * l->tan_x * l->tan_y);
     case CDL_LIGHT_DISTANT:
         return cdl_scale(l->L, CDL_PI * l->radius * l->radius);
     case CDL_LIGHT_INFINITE: /* the flux through the disk facing each direction */
@@ -284,7 +378,7 @@ cdl_vec3 cdl_light_power(const cdl_light *l)
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    return cdl_scale(l->L, CDL_PI * l->area * (l->twosided ? 2.0f : 1.0f));
+    return cdl_scale(l->tex ? cdl_mul(l->L, l->tex_mean) : l->L, CDL_PI * l->area * (l->twosided ? 2.0f : 1.0f));
 }
 
 cdl_vec3 cdl_light_env_Le(const cdl_light *l, cdl_vec3 w)

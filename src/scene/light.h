@@ -1,8 +1,8 @@
 /* Lights, behind one interface for next-event estimation (sample a point
  * towards a receiver, and its density) and for light paths (sample an
- * emitted ray). Area lights are triangles and analytic spheres; point and
- * spot lights are delta in position, distant lights in direction; the
- * infinite light is constant radiance from all directions. */
+ * emitted ray). Area lights are triangles and analytic spheres; point,
+ * spot and projector lights are delta in position, distant lights in
+ * direction; the infinite light is constant radiance from all directions. */
 #ifndef CDL_LIGHT_H
 #define CDL_LIGHT_H
 
@@ -16,10 +16,12 @@ typedef enum cdl_light_type {
     CDL_LIGHT_POINT,
     CDL_LIGHT_SPOT,
     CDL_LIGHT_DISTANT,
-    CDL_LIGHT_INFINITE
+    CDL_LIGHT_INFINITE,
+    CDL_LIGHT_PROJECTOR /* Mitsuba's projector: a pinhole projecting an image */
 } cdl_light_type;
 
 struct cdl_envmap;
+struct cdl_texture;
 
 typedef struct cdl_light {
     cdl_light_type type;
@@ -31,11 +33,27 @@ typedef struct cdl_light {
     float area;      /* triangle or sphere surface area */
     float radius;    /* sphere radius; distant/infinite: scene bounding radius */
     float cos_total, cos_falloff; /* spot cone (pbrt-v3 falloff) */
-    cdl_vec3 L;      /* radiance (area, distant, infinite) or intensity W/sr (point, spot) */
+    cdl_vec3 L;      /* radiance (area, distant, infinite) or intensity W/sr (point, spot);
+                        projector: pi scale times its constant irradiance (or 1, textured) */
     int twosided;    /* triangle: emits from both faces */
     int inward;      /* sphere: emits towards its inside (ReverseOrientation) */
     uint32_t prim;   /* triangle or sphere index in the scene */
     const struct cdl_envmap *map; /* infinite: its radiance map (NULL: constant L) */
+    /* Mitsuba's spot: intensity linear in the angle from cutoff (0) to
+     * beam (1), instead of pbrt-v3's smooth falloff over the cosines */
+    int spot_linear;
+    float cutoff, beam; /* radians */
+    /* spot and projector: unit frame (ax, ay, n) and the tangents of the
+     * image's half extents at distance 1; a spot's uv spans its cutoff cone */
+    cdl_vec3 ax, ay;
+    float tan_x, tan_y;
+    /* a texture on the light (spot: projected; projector: its irradiance;
+     * triangle: radiance over its uv); tex_id indexes the scene's textures
+     * and tex points there after the scene is committed */
+    int32_t tex_id;
+    const struct cdl_texture *tex;
+    cdl_vec3 tex_mean;   /* the texture's mean (light selection) */
+    float uv[6];         /* triangle: uv at its three vertices */
 } cdl_light;
 
 typedef struct cdl_light_sample {
@@ -54,9 +72,15 @@ typedef struct cdl_light_emit {
     float pdf_dir;    /* solid angle density of d (1 for distant) */
 } cdl_light_emit;
 
+/* Point, spot and projector: delta in position, intensity L * factor. */
+static inline int cdl_light_is_delta_pos(const cdl_light *l)
+{
+    return l->type == CDL_LIGHT_POINT || l->type == CDL_LIGHT_SPOT || l->type == CDL_LIGHT_PROJECTOR;
+}
+
 static inline int cdl_light_is_delta(const cdl_light *l)
 {
-    return l->type == CDL_LIGHT_POINT || l->type == CDL_LIGHT_SPOT || l->type == CDL_LIGHT_DISTANT;
+    return cdl_light_is_delta_pos(l) || l->type == CDL_LIGHT_DISTANT;
 }
 
 /* Distant and infinite lights: outside the scene, reached along directions. */
@@ -72,8 +96,17 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
  * reaches the light at distance dist (area and infinite lights; 0 for delta). */
 float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist);
 /* Radiance an area light emits at a point with geometric normal ng
- * towards direction wo; 0 from a back face. */
+ * towards direction wo; 0 from a back face. A textured light gives its
+ * untextured scale here; cdl_light_Le_uv takes the point's uv. */
 cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo);
+cdl_vec3 cdl_light_Le_uv(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo, float u, float v);
+/* A delta-position light's intensity towards unit direction w (leaving
+ * the light) is L times this factor: 1 (point), the cone's falloff and the
+ * projected texture (spot), irradiance / cos^3 inside the image (projector). */
+cdl_vec3 cdl_light_I_factor(const cdl_light *l, cdl_vec3 w);
+/* Solid-angle density of the direction cdl_light_sample_le chooses for a
+ * spot or projector (0 outside its cone or image). */
+float cdl_light_pdf_emit_dir(const cdl_light *l, cdl_vec3 w);
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,
                         cdl_light_emit *e);
 /* Radiance of an infinite light arriving from world direction w (unit,

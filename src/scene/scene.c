@@ -184,7 +184,7 @@ int cdl_scene_add_emitter(cdl_scene *s, cdl_vec3 L, int twosided, int32_t *id, c
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "emitted radiance must be finite and >= 0");
     if (cdl_grow((void **)&s->emitters, &s->cap_emitters, s->nemitters + 1, sizeof(cdl_emitter)))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
-    s->emitters[s->nemitters] = (cdl_emitter){L, twosided};
+    s->emitters[s->nemitters] = (cdl_emitter){L, twosided, -1};
     *id = (int32_t)s->nemitters++;
     return 0;
 }
@@ -243,10 +243,28 @@ int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *e
         return rc;
     cdl_light l;
     memset(&l, 0, sizeof l);
+    l.tex_id = -1;
     l.type = CDL_LIGHT_POINT;
     l.p = p;
     l.L = I;
     return add_light(s, &l, err);
+}
+
+int cdl_scene_add_light(cdl_scene *s, const cdl_light *l, cdl_error *err)
+{
+    int rc = check_light(s, l->p, l->L, err);
+    if (rc)
+        return rc;
+    int frame = fabsf(cdl_length(l->n) - 1.0f) < 1e-3f && fabsf(cdl_length(l->ax) - 1.0f) < 1e-3f &&
+                fabsf(cdl_length(l->ay) - 1.0f) < 1e-3f;
+    int ok = (l->type == CDL_LIGHT_SPOT && l->cos_total < 1.0f && l->cos_falloff >= l->cos_total) ||
+             (l->type == CDL_LIGHT_PROJECTOR && l->tan_x > 0.0f && l->tan_y > 0.0f && isfinite(l->tan_x) &&
+              isfinite(l->tan_y));
+    if (!frame || !ok || l->tex_id < -1 || l->tex_id >= (int32_t)s->ntexs)
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "spot or projector light: bad frame, cone or texture");
+    cdl_light c = *l;
+    c.tex = NULL;
+    return add_light(s, &c, err);
 }
 
 int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I, float cone_deg,
@@ -260,6 +278,7 @@ int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I,
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "spot light needs a direction and 0 <= conedelta <= coneangle <= 180");
     cdl_light l;
     memset(&l, 0, sizeof l);
+    l.tex_id = -1;
     l.type = CDL_LIGHT_SPOT;
     l.p = p;
     l.n = cdl_scale(dir, 1.0f / len);
@@ -279,6 +298,7 @@ int cdl_scene_add_distant_light(cdl_scene *s, cdl_vec3 dir, cdl_vec3 L, cdl_erro
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "distant light needs from != to");
     cdl_light l;
     memset(&l, 0, sizeof l);
+    l.tex_id = -1;
     l.type = CDL_LIGHT_DISTANT;
     l.n = cdl_scale(dir, 1.0f / len);
     l.L = L;
@@ -298,6 +318,7 @@ int cdl_scene_add_env_light(cdl_scene *s, cdl_vec3 L, cdl_envmap *map, cdl_error
             rc = cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "only one infinite light is supported");
     cdl_light l;
     memset(&l, 0, sizeof l);
+    l.tex_id = -1;
     l.type = CDL_LIGHT_INFINITE;
     l.L = L;
     l.map = map;
@@ -313,6 +334,16 @@ int cdl_scene_add_env_light(cdl_scene *s, cdl_vec3 L, cdl_envmap *map, cdl_error
 }
 
 /* Area lights from emitting shapes; bounds-dependent lights finished. */
+static cdl_vec3 texture_mean(const cdl_texture *t)
+{
+    double m[3] = {0.0, 0.0, 0.0};
+    size_t n = (size_t)t->w * (size_t)t->h;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            m[k] += t->rgb[3 * i + k];
+    return n ? cdl_v3((float)(m[0] / n), (float)(m[1] / n), (float)(m[2] / n)) : cdl_v3(0, 0, 0);
+}
+
 static int build_lights(cdl_scene *s, cdl_error *err)
 {
     s->tri_light = malloc(sizeof(int32_t) * (s->ntris ? s->ntris : 1));
@@ -347,6 +378,7 @@ static int build_lights(cdl_scene *s, cdl_error *err)
         const cdl_emitter *em = &s->emitters[s->tri_emit[i]];
         cdl_light l;
         memset(&l, 0, sizeof l);
+        l.tex_id = -1;
         l.type = CDL_LIGHT_TRIANGLE;
         l.p = p0;
         l.e1 = e1;
@@ -356,6 +388,11 @@ static int build_lights(cdl_scene *s, cdl_error *err)
         l.L = em->L;
         l.twosided = em->twosided;
         l.prim = i;
+        l.tex_id = em->tex;
+        for (int k = 0; k < 3 && em->tex >= 0; k++) {
+            l.uv[2 * k] = s->uv[2 * t[k]];
+            l.uv[2 * k + 1] = s->uv[2 * t[k] + 1];
+        }
         s->tri_light[i] = (int32_t)s->nlights;
         if (add_light(s, &l, err))
             return err->code;
@@ -366,11 +403,16 @@ static int build_lights(cdl_scene *s, cdl_error *err)
             continue;
         cdl_light l;
         memset(&l, 0, sizeof l);
+        l.tex_id = -1;
         l.type = CDL_LIGHT_SPHERE;
         l.p = cdl_v3(s->sph[4 * i], s->sph[4 * i + 1], s->sph[4 * i + 2]);
         l.radius = s->sph[4 * i + 3];
         l.area = 4.0f * CDL_PI * l.radius * l.radius;
         l.L = s->emitters[s->sph_emit[i]].L;
+        if (s->emitters[s->sph_emit[i]].tex >= 0) { /* no uv on candela's analytic spheres */
+            l.L = cdl_mul(l.L, texture_mean(&s->texs[s->emitters[s->sph_emit[i]].tex]));
+            cdl_warn(s->path, 0, "a textured emitter on an analytic sphere emits the texture's mean");
+        }
         l.inward = s->sph_inward[i];
         l.prim = i;
         s->sph_light[i] = (int32_t)s->nlights;
@@ -380,13 +422,35 @@ static int build_lights(cdl_scene *s, cdl_error *err)
     if (s->nlights == 0)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0,
                              "scene has no light (no emitting surface and no point_light)");
-    float *w = malloc(sizeof(float) * s->nlights);
-    if (!w)
-        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    /* the textures are all loaded now: their addresses stay */
     for (uint32_t i = 0; i < s->nlights; i++) {
-        cdl_vec3 P = cdl_light_power(&s->lights[i]);
-        w[i] = (P.x + P.y + P.z) / 3.0f;
+        cdl_light *l = &s->lights[i];
+        if (l->type == CDL_LIGHT_INFINITE || l->type == CDL_LIGHT_DISTANT || l->tex_id < 0 ||
+            l->tex_id >= (int32_t)s->ntexs) {
+            l->tex = NULL;
+            continue;
+        }
+        l->tex = &s->texs[l->tex_id];
+        l->tex_mean = texture_mean(l->tex);
     }
+    float *w = malloc(sizeof(float) * s->nlights);
+    double *emit_area = s->light_select_uniform ? calloc(s->nemitters ? s->nemitters : 1, sizeof(double)) : NULL;
+    if (!w || (s->light_select_uniform && !emit_area)) {
+        free(w);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory");
+    }
+    for (uint32_t i = 0; i < s->nlights && emit_area; i++)
+        if (s->lights[i].type == CDL_LIGHT_TRIANGLE)
+            emit_area[s->tri_emit[s->lights[i].prim]] += s->lights[i].area;
+    for (uint32_t i = 0; i < s->nlights; i++) {
+        const cdl_light *l = &s->lights[i];
+        cdl_vec3 P = cdl_light_power(l);
+        w[i] = (P.x + P.y + P.z) / 3.0f;
+        /* uniform over emitters (a mesh is one), by area within a mesh */
+        if (emit_area && w[i] > 0.0f)
+            w[i] = l->type == CDL_LIGHT_TRIANGLE ? (float)(l->area / emit_area[s->tri_emit[l->prim]]) : 1.0f;
+    }
+    free(emit_area);
     int rc = cdl_alias_build(&s->light_select, w, s->nlights);
     free(w);
     if (rc)

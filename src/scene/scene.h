@@ -12,6 +12,7 @@
 
 #include "core/alias.h"
 #include "core/error.h"
+#include "film/filter.h"
 #include "scene/bsdf.h"
 #include "scene/envmap.h"
 #include "scene/light.h"
@@ -26,6 +27,7 @@
 typedef struct cdl_emitter {
     cdl_vec3 L;   /* radiance */
     int twosided; /* triangles: both faces emit; otherwise the CCW front face */
+    int32_t tex;  /* radiance texture (scaled by L) over the triangles' uv, or -1 */
 } cdl_emitter;
 
 /* A parameter of the file's integrator block, as text, for the method's
@@ -43,6 +45,12 @@ typedef struct cdl_scene_settings {
     int has_camera;                 /* eye/right/up/fwd/fov are set */
     cdl_vec3 eye, right, up, fwd;   /* world images of camera origin and axes (pbrt) */
     float fov;                      /* degrees, on the shorter image axis */
+    int ortho;                      /* orthographic camera (Mitsuba): the extent below, no fov */
+    float ortho_half_w, ortho_near; /* half height: half_w * height / width */
+    int has_filter;                 /* the file's pixel filter (else candela's box) */
+    cdl_filter filter;
+    char filter_file[256];          /* where it was given */
+    int filter_line;
     int width, height;              /* 0 = not given */
     int spp;                        /* 0 = not given */
     int maxdepth;                   /* -1 = not given */
@@ -100,6 +108,7 @@ typedef struct cdl_scene {
     cdl_light *lights;
     uint32_t nlights, cap_lights;
     cdl_alias light_select;
+    int light_select_uniform; /* choose emitters uniformly (Mitsuba), a mesh's triangles by area, not by power */
 
     int32_t env_light;   /* index of the infinite light or -1 (after commit) */
     cdl_envmap *envmap;  /* its radiance map, or NULL */
@@ -132,6 +141,10 @@ int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *er
 int cdl_scene_add_texture_data(cdl_scene *s, cdl_texture *t, int *id, cdl_error *err);
 /* I is the intensity in W/sr. */
 int cdl_scene_add_point_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 I, cdl_error *err);
+/* A spot (spot_linear: Mitsuba's) or projector light built by a reader: p,
+ * the unit frame (ax, ay, n), L, the cone or the image's tangents and
+ * tex_id (-1: none) are checked here. */
+int cdl_scene_add_light(cdl_scene *s, const cdl_light *l, cdl_error *err);
 /* Spot at p pointing along dir; cone angles in degrees (pbrt's coneangle, conedelta). */
 int cdl_scene_add_spot_light(cdl_scene *s, cdl_vec3 p, cdl_vec3 dir, cdl_vec3 I, float cone_deg,
                              float delta_deg, cdl_error *err);

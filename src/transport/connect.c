@@ -4,25 +4,20 @@
 
 #define MAX_PATH 1100 /* > maxdepth limit (1024) + 3 */
 
-float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
+cdl_vec3 cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
 {
     switch (l->type) {
     case CDL_LIGHT_POINT:
-        return 1.0f;
-    case CDL_LIGHT_SPOT: {
-        float c = cdl_dot(w, l->n);
-        if (c < l->cos_total)
-            return 0.0f;
-        if (c >= l->cos_falloff)
-            return 1.0f;
-        float d = (c - l->cos_total) / (l->cos_falloff - l->cos_total);
-        return (d * d) * (d * d);
-    }
+    case CDL_LIGHT_SPOT:
+    case CDL_LIGHT_PROJECTOR:
+        return cdl_light_I_factor(l, w);
     case CDL_LIGHT_TRIANGLE:
-    case CDL_LIGHT_SPHERE:
-        return cdl_is_black(cdl_light_Le(l, n, w)) ? 0.0f : 1.0f;
+    case CDL_LIGHT_SPHERE: {
+        float k = cdl_is_black(cdl_light_Le(l, n, w)) ? 0.0f : 1.0f;
+        return cdl_v3(k, k, k);
+    }
     default: /* at infinity: the sampled radiance is in the vertex's throughput */
-        return 1.0f;
+        return cdl_v3(1.0f, 1.0f, 1.0f);
     }
 }
 
@@ -118,8 +113,7 @@ cdl_vec3 cdl_vertex_f_bsdf(const cdl_connect_ctx *cx, const cdl_vertex_store *vs
     cdl_vec3 p = vs->p[i];
     cdl_vec3 wt = cdl_normalize(cdl_sub(to, p));
     if (vs->flags[i] & CDL_V_LIGHT) {
-        float k = cdl_light_emit_factor(&cx->scene->lights[vs->light[i]], vs->ng[i], wt);
-        return cdl_v3(k, k, k);
+        return cdl_light_emit_factor(&cx->scene->lights[vs->light[i]], vs->ng[i], wt);
     }
     cdl_vec3 wf = cdl_normalize(cdl_sub(from, p));
     if (!light_side)
@@ -198,7 +192,7 @@ cdl_vec3 cdl_connect_eye_only(const cdl_connect_ctx *cx, const cdl_vertex_store 
     const cdl_light *l = &cx->scene->lights[evs->light[i]];
     int inf = (evs->flags[i] & CDL_V_INFINITE) != 0;
     cdl_vec3 d = cdl_neg(evs->wi[i]); /* at infinity: towards the sky */
-    cdl_vec3 Le = inf ? cdl_light_env_Le(l, d) : cdl_light_Le(l, evs->ng[i], evs->wi[i]);
+    cdl_vec3 Le = inf ? cdl_light_env_Le(l, d) : cdl_light_Le_uv(l, evs->ng[i], evs->wi[i], evs->u[i], evs->v[i]);
     if (cdl_is_black(Le))
         return zero;
     cdl_vec3 c = cdl_mul(evs->beta[i], Le);

@@ -78,7 +78,8 @@ int cdl_visible(const cdl_scene *s, cdl_vec3 pa, cdl_vec3 na, cdl_vec3 pb, cdl_v
                 uint32_t skip_sphere);
 
 /* The fraction of a light's emission y_0 sends towards unit w: 1 or 0
- * for diffuse area lights, the falloff for spots, 1 for points. */
-float cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w);
+ * for diffuse area lights; for point, spot and projector lights the
+ * direction's factor of their intensity (cdl_light_I_factor). */
+cdl_vec3 cdl_light_emit_factor(const cdl_light *l, cdl_vec3 n, cdl_vec3 w);
 
 #endif

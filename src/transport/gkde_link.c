@@ -297,7 +297,7 @@ cdl_vec3 cdl_gkde_emitted(const cdl_gkde_ctx *g, uint32_t y)
         return zero;
     const cdl_light *l = &g->cx.scene->lights[evs->light[y]];
     int inf = (evs->flags[y] & CDL_V_INFINITE) != 0; /* the eye path left the scene */
-    cdl_vec3 Le = inf ? cdl_light_env_Le(l, cdl_neg(evs->wi[y])) : cdl_light_Le(l, evs->ng[y], evs->wi[y]);
+    cdl_vec3 Le = inf ? cdl_light_env_Le(l, cdl_neg(evs->wi[y])) : cdl_light_Le_uv(l, evs->ng[y], evs->wi[y], evs->u[y], evs->v[y]);
     if (cdl_is_black(Le))
         return zero;
     cdl_vec3 c = cdl_mul(evs->beta[y], Le);

@@ -8,7 +8,8 @@ float cdl_light_pdf_dir(const cdl_light *l, cdl_vec3 n, cdl_vec3 w)
     case CDL_LIGHT_POINT:
         return 0.25f * CDL_INV_PI;
     case CDL_LIGHT_SPOT:
-        return cdl_dot(w, l->n) >= l->cos_total ? 1.0f / (2.0f * CDL_PI * (1.0f - l->cos_total)) : 0.0f;
+    case CDL_LIGHT_PROJECTOR:
+        return cdl_light_pdf_emit_dir(l, w);
     case CDL_LIGHT_TRIANGLE:
     case CDL_LIGHT_SPHERE: {
         float c = cdl_dot(n, w);
@@ -183,8 +184,9 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     vs->ng[i] = vs->ns[i] = e.n;
     vs->wi[i] = cdl_v3(0.0f, 0.0f, 0.0f);
     /* y_0 carries the emitted radiance per unit area density; the
-     * direction's distribution is applied at connection (Le_dir). */
-    vs->beta[i] = cdl_scale(e.Le, 1.0f / (pmf * e.pdf_pos));
+     * direction's distribution is applied at connection (Le_dir; for
+     * point, spot and projector lights all of it: cdl_light_I_factor). */
+    vs->beta[i] = cdl_scale(cdl_light_is_delta_pos(l) ? l->L : e.Le, 1.0f / (pmf * e.pdf_pos));
     vs->pdf_fwd[i] = pmf * e.pdf_pos;
     vs->parent[i] = -1;
     vs->light[i] = (int32_t)li;

@@ -25,7 +25,7 @@ int cdl_find_visible(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, int maxdepth, c
         v->wo = cdl_neg(d);
         v->depth = depth;
         if (v->sf.light >= 0)
-            v->L = cdl_add(v->L, cdl_mul(v->beta, cdl_light_Le(&s->lights[v->sf.light], v->sf.ng, v->wo)));
+            v->L = cdl_add(v->L, cdl_mul(v->beta, cdl_light_Le_uv(&s->lights[v->sf.light], v->sf.ng, v->wo, v->sf.u, v->sf.v)));
         if (depth >= maxdepth)
             return 0;
         if (!cdl_bsdf_is_delta(&v->b))
