@@ -24,8 +24,9 @@ int cdl_scene_group_begin(cdl_scene *s, uint32_t *id, cdl_error *err)
     return 0;
 }
 
-/* A copy of n items of size sz (NULL when n is 0); 0 on success. */
-static int take(void **out, const void *from, uint32_t n, size_t sz)
+/* A copy of items first .. first + n of size sz from the array base (NULL
+ * when n is 0, and base is not touched: it may be NULL); 0 on success. */
+static int take(void **out, const void *base, uint32_t first, uint32_t n, size_t sz)
 {
     *out = NULL;
     if (!n)
@@ -33,7 +34,7 @@ static int take(void **out, const void *from, uint32_t n, size_t sz)
     *out = malloc(sz * n);
     if (!*out)
         return -1;
-    memcpy(*out, from, sz * n);
+    memcpy(*out, (const char *)base + sz * first, sz * n);
     return 0;
 }
 
@@ -49,12 +50,12 @@ int cdl_scene_group_end(cdl_scene *s, cdl_error *err)
         return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "no shape group is open");
     cdl_group *g = &s->groups[s->open_group];
     uint32_t nt = s->ntris - g->first_tri, ns = s->nspheres - g->first_sph;
-    if (take((void **)&g->idx, s->idx + 3 * (size_t)g->first_tri, nt, 3 * sizeof(uint32_t)) ||
-        take((void **)&g->tri_mat, s->tri_mat + g->first_tri, nt, sizeof(uint32_t)) ||
-        take((void **)&g->tri_flags, s->tri_flags + g->first_tri, nt, sizeof(uint8_t)) ||
-        take((void **)&g->sph, s->sph + 4 * (size_t)g->first_sph, ns, 4 * sizeof(float)) ||
-        take((void **)&g->sph_mat, s->sph_mat + g->first_sph, ns, sizeof(uint32_t)) ||
-        take((void **)&g->sph_inward, s->sph_inward + g->first_sph, ns, sizeof(uint8_t)) ||
+    if (take((void **)&g->idx, s->idx, g->first_tri, nt, 3 * sizeof(uint32_t)) ||
+        take((void **)&g->tri_mat, s->tri_mat, g->first_tri, nt, sizeof(uint32_t)) ||
+        take((void **)&g->tri_flags, s->tri_flags, g->first_tri, nt, sizeof(uint8_t)) ||
+        take((void **)&g->sph, s->sph, g->first_sph, ns, 4 * sizeof(float)) ||
+        take((void **)&g->sph_mat, s->sph_mat, g->first_sph, ns, sizeof(uint32_t)) ||
+        take((void **)&g->sph_inward, s->sph_inward, g->first_sph, ns, sizeof(uint8_t)) ||
         (nt && !(g->face_n = malloc(sizeof(cdl_vec3) * nt))))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for a shape group");
     g->ntris = nt;
