@@ -46,6 +46,9 @@ PASSING = [
     "floating_sphere/test_directional_direct.xml",
     "infinite_mirrors/scene_path.xml",
     "instancing/test_instancing_path.xml",
+    "mesh_attributes/test_mesh_attributes_1_face_direct.xml",
+    "mesh_attributes/test_mesh_attributes_3_face_direct.xml",
+    "mesh_attributes/test_mesh_attributes_3_vertex_direct.xml",
     "orthographic_sensor/test_orthographic_path.xml",
     "participating_media/test_surf_area_light_volpath.xml",
     "projector/test_projector_constant_direct.xml",
@@ -57,12 +60,6 @@ PASSING = [
 
 # the measured reason each other scene fails (README, "Mitsuba 3 render tests")
 FAILING = {
-    "mesh_attributes/test_mesh_attributes_1_face_direct.xml":
-        "mesh_attribute textures and blendbsdf not implemented (a constant 0.5, the first bsdf): Y ratio 0.59",
-    "mesh_attributes/test_mesh_attributes_3_face_direct.xml":
-        "mesh_attribute texture (per-face colour from the PLY) not implemented: a constant 0.5, Y ratio 1.09",
-    "mesh_attributes/test_mesh_attributes_3_vertex_direct.xml":
-        "mesh_attribute texture (per-vertex colour from the PLY) not implemented: a constant 0.5, Y ratio 0.99",
     "various_shapes/test_various_shapes_path.xml":
         "the sdfgrid shape (a torus, instanced) is skipped; the open cylinder's inside is lit (candela's "
         "opaque bsdfs are two-sided, Mitsuba's one-sided)",

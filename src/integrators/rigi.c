@@ -192,6 +192,7 @@ static cdl_vec3 eye_path(const rigi_state *st, cdl_sampler *smp, cdl_vec3 o, cdl
             w->eye.beta[i] = beta;
             w->eye.u[i] = sf.u;
             w->eye.v[i] = sf.v;
+            w->eye.kdh[i] = sf.kdh;
             w->eye.ts[i] = sf.ts;
             w->eye.nb[i] = sf.nb;
             w->eye.mat[i] = sf.mat;

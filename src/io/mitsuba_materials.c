@@ -422,6 +422,70 @@ static int principled(cdl_mts_ctx *c, cdl_xml_node *n, int thin, cdl_material *m
     return 0;
 }
 
+/* Mitsuba's blendbsdf: (1 - weight) first + weight second, chosen per hit
+ * (scene/attr.h); two plain diffuse bsdfs blend their reflectances. */
+static int blend(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    int32_t kid[2];
+    int nk = 0, rc, tex;
+    double w;
+    if ((rc = cdl_mts_float_or_texture(c, n, "weight", 0.5, &w, &tex)))
+        return rc;
+    if (!(w >= 0.0 && w <= 1.0) && tex < 0)
+        return cdl_mts_error(c, n->line, "blendbsdf weight %g must be in [0, 1]", w);
+    for (int i = 0; i < n->nkids && !rc; i++) {
+        cdl_xml_node *k = &n->kids[i];
+        const cdl_mts_id *d = NULL;
+        if (!strcmp(k->name, "ref")) {
+            const char *id = cdl_mts_attr(c, k, "id", &rc);
+            if (rc || !id || !(d = cdl_mts_find_id(c, id)) || d->kind != CDL_MTS_BSDF)
+                continue; /* the weight's texture, or an error reported by it */
+        } else if (strcmp(k->name, "bsdf")) {
+            continue;
+        }
+        if (nk == 2)
+            return cdl_mts_error(c, k->line, "blendbsdf blends two bsdfs");
+        k->used = 1;
+        if (d) {
+            kid[nk++] = d->mat;
+        } else if (!(rc = cdl_mts_bsdf(c, k, &kid[nk])))
+            rc = nested_id(c, k, CDL_MTS_BSDF, kid[nk++], -1, cdl_v3(0, 0, 0));
+    }
+    if (rc)
+        return rc;
+    if (nk != 2)
+        return cdl_mts_error(c, n->line, "blendbsdf needs two nested bsdfs (<bsdf> or <ref>), not %d", nk);
+    if (kid[0] < 0 || kid[1] < 0) {
+        cdl_mts_warn(c, n->line, "blendbsdf of a null bsdf: the other one is rendered");
+        *mat = kid[0] < 0 ? kid[1] : kid[0];
+        return 0;
+    }
+    cdl_material m = cdl_material_default(CDL_MAT_BLEND);
+    m.blend[0] = kid[0];
+    m.blend[1] = kid[1];
+    m.blend_w = tex >= 0 ? 1.0f : (float)w;
+    m.blend_tex = tex;
+    const cdl_material *a = &c->s->mats[kid[0]], *b = &c->s->mats[kid[1]];
+    uint32_t idx;
+    if (a->type == CDL_MAT_DIFFUSE && b->type == CDL_MAT_DIFFUSE && !a->masked && !b->masked && !a->maps.on &&
+        !b->maps.on) {
+        cdl_material d = cdl_material_default(CDL_MAT_DIFFUSE);
+        d.kd = cdl_v3(1.0f, 1.0f, 1.0f);
+        d.hit_kd = 1;
+        snprintf(d.name, sizeof d.name, "blend-of-diffuse");
+        if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &d, &idx, c->err))))
+            return rc;
+        m.blend_as = (int)idx;
+    }
+    const char *id = cdl_xml_attr_get(n, "id");
+    snprintf(m.name, sizeof m.name, "%.63s", id ? id : "blendbsdf");
+    cdl_mts_warn_unused(c, n, "bsdf \"blendbsdf\"");
+    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+        return rc;
+    *mat = (int32_t)idx;
+    return 0;
+}
+
 int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
     char type[64];
@@ -432,8 +496,9 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     /* wrappers: the surface is the nested bsdf's */
     if (!strcmp(type, "mask"))
         return mask(c, n, mat);
-    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "blendbsdf", "coating",
-                                       "roughcoating"};
+    if (!strcmp(type, "blendbsdf"))
+        return blend(c, n, mat);
+    static const char *const wrap[] = {"twosided", "bumpmap", "normalmap", "coating", "roughcoating"};
     if (!strcmp(type, "bumpmap") || !strcmp(type, "normalmap"))
         return cdl_mts_perturbed_bsdf(c, n, type, mat);
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
@@ -549,7 +614,7 @@ int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value)
     *tex = -1;
     *value = cdl_v3(1, 1, 1);
     if (!strcmp(type, "bitmap") || !strcmp(type, "checkerboard") || !strcmp(type, "scale") ||
-        !strcmp(type, "rawconstant")) {
+        !strcmp(type, "rawconstant") || !strcmp(type, "mesh_attribute")) {
         if ((rc = cdl_mts_texture_plugin(c, n, type, tex, value)))
             return rc;
     } else {

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/attr.h"
 #include "scene/instance.h"
 #include "scene/mesh.h"
 #include "io/mitsuba_internal.h"
@@ -224,6 +225,20 @@ static int instance(cdl_mts_ctx *c, cdl_xml_node *n)
     return cdl_mts_scene_rc(c, n->line, cdl_scene_add_instance(c->s, (uint32_t)g->tex, &m, c->err));
 }
 
+/* A bsdf that reads a mesh attribute the shape lacks fails, as in Mitsuba. */
+static int check_attrs(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, int32_t mat, const cdl_mesh *m)
+{
+    int face = 0;
+    const char *miss = cdl_material_missing_attr(c->s, (uint32_t)mat, m, &face);
+    if (miss)
+        return cdl_mts_error(c, n->line, "shape \"%s\": its bsdf reads mesh attribute \"%s\", which the shape does "
+                                         "not have", type, miss);
+    if (face && c->in_group)
+        cdl_mts_warn(c, n->line, "shape \"%s\" in a shapegroup: its face attributes are not instanced (read as 0)",
+                     type);
+    return 0;
+}
+
 /* The shape's surface: a nested <bsdf>, a <ref> to one, or Mitsuba's default. */
 static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
@@ -303,6 +318,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
             return cdl_mts_scene_rc(c, n->line, cdl_scene_add_sphere(c->s, w, (float)(r * scale), (uint32_t)mat, emit,
                                                                      flip, c->err));
         }
+        if ((rc = check_attrs(c, n, type, mat, NULL)))
+            return rc;
         cdl_mesh sm;
         if (!(rc = cdl_mesh_sphere(&sm, r, flip, c->file, n->line, c->err)))
             rc = cdl_scene_add_mesh(c->s, &sm, &full, 0, (uint32_t)mat, emit, c->file, n->line, c->err);
@@ -332,7 +349,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++)
             cdl_mts_prop(c, n, quiet[i]);
         cdl_mts_warn_unused(c, n, type);
-        rc = cdl_scene_add_mesh(c->s, &mesh, &m, reverse, (uint32_t)mat, emit, c->file, n->line, c->err);
+        if (!(rc = check_attrs(c, n, type, mat, &mesh)))
+            rc = cdl_scene_add_mesh(c->s, &mesh, &m, reverse, (uint32_t)mat, emit, c->file, n->line, c->err);
     }
     cdl_mesh_free(&mesh);
     return rc;

@@ -1,4 +1,5 @@
-/* Mitsuba textures (bitmap, checkerboard, scale, rawconstant), textured
+/* Mitsuba textures (bitmap, checkerboard, scale, rawconstant,
+ * mesh_attribute), textured
  * roughness, the bumpmap and normalmap wrappers and Mitsuba's named
  * conductors, as Mitsuba 3 defines them (src/textures/, src/bsdfs/). */
 #define _POSIX_C_SOURCE 200809L
@@ -165,6 +166,29 @@ static int scale_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex)
     return add(c, n->line, &t, tex);
 }
 
+/* Mitsuba 3's mesh_attribute: a shape's "vertex_*" (interpolated) or
+ * "face_*" attribute, times scale; read at the hit (scene/attr.h). */
+static int mesh_attribute(cdl_mts_ctx *c, cdl_xml_node *n, int *tex)
+{
+    char name[256];
+    double sc;
+    int rc;
+    if ((rc = cdl_mts_string(c, n, "name", NULL, name, sizeof name)) || (rc = cdl_mts_float(c, n, "scale", 1.0, &sc)))
+        return rc;
+    if (strncmp(name, "vertex_", 7) && strncmp(name, "face_", 5))
+        return cdl_mts_error(c, n->line, "mesh_attribute name \"%s\" must start with vertex_ or face_", name);
+    if (strlen(name) >= CDL_ATTR_NAME)
+        return cdl_mts_error(c, n->line, "mesh_attribute name \"%s\" is longer than %d characters", name,
+                             CDL_ATTR_NAME - 1);
+    if (!(fabs(sc) < 1e12))
+        return cdl_mts_error(c, n->line, "scale %g out of range", sc);
+    cdl_texture t;
+    cdl_texture_init(&t, CDL_TEX_ATTRIBUTE);
+    snprintf(t.attr, sizeof t.attr, "%s", name);
+    t.scale = (float)sc;
+    return add(c, n->line, &t, tex);
+}
+
 int cdl_mts_texture_plugin(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, int *tex, cdl_vec3 *value)
 {
     *tex = -1;
@@ -175,6 +199,8 @@ int cdl_mts_texture_plugin(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, in
         return checkerboard(c, n, tex);
     if (!strcmp(type, "scale"))
         return scale_texture(c, n, tex);
+    if (!strcmp(type, "mesh_attribute"))
+        return mesh_attribute(c, n, tex);
     /* rawconstant: a value used as it is (a normal map's (0.5, 0.5, 1)) */
     cdl_xml_node *p = cdl_mts_prop(c, n, "value");
     if (!p)

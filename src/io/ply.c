@@ -327,8 +327,34 @@ static int oom(ply_ctx *c)
     return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->path, 0, "out of memory");
 }
 
+/* Grows element e's attribute arrays to cap values each. */
+static int grow_attrs(ply_ctx *c, ply_elem *e, uint64_t cap)
+{
+    for (int k = 0; k < e->nattrs; k++) {
+        float *p = realloc(e->attrs[k].data, (size_t)cap * (size_t)e->attrs[k].dim * sizeof(float));
+        if (!p)
+            return oom(c);
+        e->attrs[k].data = p;
+    }
+    return 0;
+}
+
+/* An attribute value: integers are normalized to [0, 1] (or [-1, 1]) and
+ * decoded from sRGB, as Mitsuba's struct conversion does. */
+static float attr_value(int type, double d)
+{
+    static const double range[] = {127.0, 255.0, 32767.0, 65535.0, 2147483647.0, 4294967295.0};
+    if (!IS_INT_TYPE(type))
+        return (float)d;
+    double x = d / range[type];
+    double m = fabs(x), lin = m <= 0.04045 ? m / 12.92 : pow((m + 0.055) / 1.055, 2.4);
+    return (float)(x < 0.0 ? -lin : lin);
+}
+
 static int grow_verts(ply_ctx *c, uint64_t cap, int has_n, int has_uv)
 {
+    if (grow_attrs(c, &c->elems[c->vert], cap))
+        return CDL_ERR_SYSTEM;
     float *p = realloc(c->out.pos, (size_t)cap * 3 * sizeof(float));
     if (!p)
         return oom(c);
@@ -388,6 +414,14 @@ static int read_vertices(ply_ctx *c, const ply_elem *e)
             int64_t iv;
             if ((rc = read_value(c, pr->type, &d, &iv)))
                 return rc;
+            if (pr->role == R_ATTR) {
+                const ply_attr *a = &e->attrs[pr->attr];
+                if (!isfinite(d))
+                    return elem_error(c, "%s is not finite (%g)", pr->name, d);
+                if (pr->chan >= 0)
+                    a->data[(size_t)a->dim * i + (unsigned)pr->chan] = attr_value(pr->type, d);
+                continue;
+            }
             if (!isfinite(d))
                 return elem_error(c, "%s is not finite (%g)", role_name[pr->role], d);
             if (fabs(d) > CDL_MAX_COORD)
@@ -418,7 +452,7 @@ static int grow_tris(ply_ctx *c)
         return oom(c);
     c->out.idx = p;
     c->tcap = nc;
-    return 0;
+    return grow_attrs(c, &c->elems[c->face], nc);
 }
 
 /* The index list of one face, fan-triangulated around its first vertex. */
@@ -469,16 +503,58 @@ static int read_faces(ply_ctx *c, const ply_elem *e)
         if (!(c->out.idx = malloc((size_t)cap * 3 * sizeof(uint32_t))))
             return oom(c);
         c->tcap = cap;
+        if (grow_attrs(c, &c->elems[c->face], cap))
+            return CDL_ERR_SYSTEM;
     }
     for (uint64_t i = 0; i < e->count; i++) {
         c->cur_i = i;
+        uint32_t t0 = c->out.ntris;
+        float val[PLY_MAX_ATTRS][3] = {{0}};
         int rc = begin_instance(c);
         for (int k = 0; !rc && k < e->nprops; k++) {
             const ply_prop *pr = &e->props[k];
+            if (pr->role == R_ATTR) {
+                double d;
+                int64_t iv;
+                if (!(rc = read_value(c, pr->type, &d, &iv)) && !isfinite(d))
+                    rc = elem_error(c, "%s is not finite (%g)", pr->name, d);
+                if (!rc && pr->chan >= 0)
+                    val[pr->attr][pr->chan] = attr_value(pr->type, d);
+                continue;
+            }
             rc = pr->role == R_INDICES ? read_face_indices(c, pr) : skip_prop(c, pr);
         }
         if (rc || (rc = end_instance(c)))
             return rc;
+        /* every triangle of the face's fan gets the face's values */
+        for (int k = 0; k < e->nattrs; k++)
+            for (uint32_t t = t0; t < c->out.ntris; t++)
+                memcpy(e->attrs[k].data + (size_t)e->attrs[k].dim * t, val[k],
+                       (size_t)e->attrs[k].dim * sizeof(float));
+    }
+    return 0;
+}
+
+/* Hands the attributes over to the mesh (which owns them from then on). */
+static int take_attrs(ply_ctx *c)
+{
+    for (int w = 0; w < 2; w++) {
+        ply_elem *e = &c->elems[w ? c->face : c->vert];
+        for (int k = 0; k < e->nattrs; k++) {
+            cdl_mesh_attr *a = realloc(c->out.attrs, sizeof *a * (size_t)(c->out.nattrs + 1));
+            if (!a)
+                return oom(c);
+            c->out.attrs = a;
+            a += c->out.nattrs++;
+            memset(a, 0, sizeof *a);
+            snprintf(a->name, sizeof a->name, "%s", e->attrs[k].name);
+            a->per_face = w;
+            a->dim = e->attrs[k].dim;
+            a->data = e->attrs[k].data;
+            e->attrs[k].data = NULL;
+            if (!a->data) /* an empty element */
+                c->out.nattrs--;
+        }
     }
     return 0;
 }
@@ -522,6 +598,8 @@ int cdl_ply_read(const char *path, cdl_ply_mesh *m, cdl_error *err)
     }
     if (!rc && c->out.ntris == 0)
         rc = cdl_error_set(err, CDL_ERR_INPUT, path, 0, "no faces");
+    if (!rc)
+        rc = take_attrs(c);
     if (!rc) {
         c->out.nverts = c->nverts;
         if (c->tcap > c->out.ntris) { /* give back the reserve; keep it if realloc fails */
@@ -533,6 +611,9 @@ int cdl_ply_read(const char *path, cdl_ply_mesh *m, cdl_error *err)
     } else {
         cdl_ply_free(&c->out);
     }
+    for (int i = 0; i < c->nelems; i++)
+        for (int k = 0; k < c->elems[i].nattrs; k++)
+            free(c->elems[i].attrs[k].data);
     free(c);
     free(data);
     return rc;

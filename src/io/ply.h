@@ -4,8 +4,11 @@
  * From the "vertex" element it takes x y z, optionally nx ny nz and a
  * texture coordinate pair (u v, s t, texture_u texture_v or texture_s
  * texture_t); from the "face" element the vertex_indices (or vertex_index)
- * list, fan-triangulating polygons. Every other property and element is
- * skipped. The whole file is read into memory and parsed there.
+ * list, fan-triangulating polygons. The other scalar properties of those
+ * two elements become the mesh's attributes, named and grouped as Mitsuba
+ * does ("vertex_color" from color_0..2 or r g b, "face_weight" from
+ * weight_0; a face's values go to each triangle of its fan); integer
+ * ones are normalized and decoded from sRGB. Other elements are skipped. The whole file is read into memory and parsed there.
  *
  * Errors name the file and, for the header and ASCII bodies, the 1-based
  * text line; binary bodies have no lines, so their errors give line 0 and

@@ -29,19 +29,33 @@ typedef struct ply_type {
 extern const ply_type cdl_ply_types[T_NTYPES];
 
 /* What a property is used for; everything else is read and dropped. */
-enum { R_SKIP, R_X, R_Y, R_Z, R_NX, R_NY, R_NZ, R_U, R_V, R_INDICES };
+enum { R_SKIP, R_X, R_Y, R_Z, R_NX, R_NY, R_NZ, R_U, R_V, R_INDICES, R_ATTR };
 
 typedef struct ply_prop {
     const char *name; /* points into the (NUL-split) header */
     int type;         /* item type for lists */
     int list, count_type, role, line;
+    int attr, chan;   /* R_ATTR: the element's attribute and channel */
 } ply_prop;
+
+/* Mitsuba's grouping of a vertex's or face's other scalar properties:
+ * consecutive {prefix}_{x|y|z|w}, _{r|g|b|a}, _{0..3} or _{1..4} (and a
+ * bare r g b a or red green blue alpha, prefix "color") form one
+ * attribute "{vertex|face}_{prefix}"; channels past the third are dropped. */
+#define PLY_MAX_ATTRS 16
+typedef struct ply_attr {
+    char name[CDL_ATTR_NAME];
+    int dim;     /* channels kept, 1..3 */
+    float *data; /* dim per vertex, or per triangle for faces */
+} ply_attr;
 
 typedef struct ply_elem {
     const char *name;
     uint64_t count;
     int line, nprops;
     ply_prop props[PLY_MAX_PROPS];
+    int nattrs;
+    ply_attr attrs[PLY_MAX_ATTRS];
 } ply_elem;
 
 typedef struct ply_ctx {

@@ -4,6 +4,7 @@
 #include "io/ply_format.h"
 
 #include <inttypes.h>
+#include <stdio.h>
 #include <string.h>
 
 /* ---- types -------------------------------------------------------------------------------- */
@@ -134,6 +135,77 @@ static int parse_element(ply_ctx *c, char **cur, int line)
     return 0;
 }
 
+/* The attribute prefix of property name n and its channel letter (0 when
+ * the name has no channel suffix). */
+static char attr_split(const char *n, char *prefix, size_t size)
+{
+    static const char *bare[2][4] = {{"r", "g", "b", "a"}, {"red", "green", "blue", "alpha"}};
+    for (int s = 0; s < 2; s++)
+        for (int k = 0; k < 4; k++)
+            if (!strcmp(n, bare[s][k])) {
+                snprintf(prefix, size, "color");
+                return "rgba"[k];
+            }
+    const char *us = strrchr(n, '_');
+    if (us && us > n && us[1] && !us[2] && strchr("xyzwrgba01234", us[1])) {
+        snprintf(prefix, size, "%.*s", (int)(us - n), n);
+        return us[1];
+    }
+    snprintf(prefix, size, "%s", n);
+    return 0;
+}
+
+/* Channel of letter ch in a group that started with letter first (or -1:
+ * not its scheme). */
+static int attr_chan(char first, char ch)
+{
+    static const char *schemes[] = {"xyzw", "rgba", "0123", "1234"};
+    for (int s = 0; s < 4; s++)
+        if (schemes[s][0] == first && ch && strchr(schemes[s], ch))
+            return (int)(strchr(schemes[s], ch) - schemes[s]);
+    return -1;
+}
+
+/* Groups e's unused scalar properties into attributes named kind_prefix. */
+static void assign_attrs(ply_elem *e, const char *kind)
+{
+    char prev[CDL_ATTR_NAME] = "", first = 0;
+    int prev_chan = -2;
+    for (int i = 0; i < e->nprops; i++) {
+        ply_prop *p = &e->props[i];
+        char prefix[CDL_ATTR_NAME];
+        if (p->role != R_SKIP || p->list) {
+            prev_chan = -2;
+            continue;
+        }
+        char ch = attr_split(p->name, prefix, sizeof prefix);
+        int chan = prev_chan >= 0 && !strcmp(prefix, prev) ? attr_chan(first, ch) : -1;
+        if (chan < 0 || chan != prev_chan + 1) { /* a new attribute */
+            if (e->nattrs == PLY_MAX_ATTRS)
+                continue;
+            ply_attr *a = &e->attrs[e->nattrs++];
+            size_t nk = strlen(kind), np = strlen(prefix); /* long names are cut */
+            if (nk + 1 + np >= sizeof a->name)
+                np = sizeof a->name - nk - 2;
+            memcpy(a->name, kind, nk);
+            a->name[nk] = '_';
+            memcpy(a->name + nk + 1, prefix, np);
+            a->name[nk + 1 + np] = 0;
+            a->dim = 0;
+            first = ch;
+            chan = attr_chan(first, ch) == 0 ? 0 : -2; /* -2: a lone property */
+        }
+        ply_attr *a = &e->attrs[e->nattrs - 1];
+        p->role = R_ATTR;
+        p->attr = e->nattrs - 1;
+        p->chan = a->dim < 3 ? a->dim : -1;
+        if (a->dim < 3)
+            a->dim++;
+        snprintf(prev, sizeof prev, "%s", prefix);
+        prev_chan = chan;
+    }
+}
+
 /* Marks which properties are kept and checks the vertex and face elements. */
 static int assign_roles(ply_ctx *c)
 {
@@ -182,6 +254,8 @@ static int assign_roles(ply_ctx *c)
                              "face property '%s' must hold integers, not %s", ix->name,
                              cdl_ply_types[ix->type].name);
     ix->role = R_INDICES;
+    assign_attrs(v, "vertex");
+    assign_attrs(f, "face");
     c->nverts = (uint32_t)v->count;
     return 0;
 }

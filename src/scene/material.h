@@ -20,7 +20,9 @@ typedef enum cdl_mat_type {
                               * index eta reflecting ks F (a Dirac lobe); see plastic.h */
     CDL_MAT_ROUGH_COATED,    /* Mitsuba's roughplastic: the same under a rough coat (mf, alpha_x) */
     CDL_MAT_ROUGH_DIFFUSE,   /* Oren-Nayar of reflectance kd, slope deviation sigma (oren_nayar.h) */
-    CDL_MAT_PRINCIPLED       /* Mitsuba 3's principled(thin): base colour kd, the rest in pr */
+    CDL_MAT_PRINCIPLED,      /* Mitsuba 3's principled(thin): base colour kd, the rest in pr */
+    CDL_MAT_BLEND            /* Mitsuba's blendbsdf: material blend[0] or blend[1] by weight,
+                              * decided at each hit (scene/attr.h); never a BSDF itself */
 } cdl_mat_type;
 
 /* Entries of the rough coat's transmittance table (Mitsuba's
@@ -78,6 +80,12 @@ typedef struct cdl_material {
     int opacity_tex;  /* texture index or -1 */
     cdl_mat_maps maps; /* textured roughness, bump and normal maps */
     cdl_principled pr; /* principled: parameters other than the base colour */
+    /* blend: (1 - w) blend[0] + w blend[1], w = blend_w times texture blend_tex;
+     * blend_as >= 0: both are plain diffuse and the hit becomes that diffuse
+     * material with the blended reflectance (exact, not a random choice) */
+    int blend[2], blend_tex, blend_as;
+    float blend_w;
+    int hit_kd;        /* kd times the surface's kdh (set at the hit), not the kd texture */
     char name[64];
 } cdl_material;
 
@@ -125,6 +133,7 @@ static inline cdl_material cdl_material_default(cdl_mat_type type)
     m.alpha_x = m.alpha_y = 0.1f;
     m.maps.alpha_tex[0] = m.maps.alpha_tex[1] = m.maps.bump_tex = m.maps.normal_tex = -1;
     m.maps.bump_scale = 1.0f;
+    m.blend_tex = m.blend_as = -1;
     return m;
 }
 

@@ -3,6 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "scene/mesh.h"
 
+#include "scene/attr.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,7 +37,28 @@ void cdl_mesh_free(cdl_mesh *m)
     free(m->nrm);
     free(m->uv);
     free(m->idx);
+    for (int i = 0; i < m->nattrs; i++)
+        free(m->attrs[i].data);
+    free(m->attrs);
     memset(m, 0, sizeof *m);
+}
+
+cdl_mesh_attr *cdl_mesh_add_attr(cdl_mesh *m, const char *name, int per_face, int dim)
+{
+    cdl_mesh_attr *a = realloc(m->attrs, sizeof *a * (size_t)(m->nattrs + 1));
+    if (!a)
+        return NULL;
+    m->attrs = a;
+    a += m->nattrs;
+    memset(a, 0, sizeof *a);
+    snprintf(a->name, sizeof a->name, "%s", name);
+    a->per_face = per_face;
+    a->dim = dim;
+    size_t n = per_face ? m->ntris : m->nverts;
+    if (!(a->data = calloc(n ? n * (size_t)dim : 1, sizeof(float))))
+        return NULL;
+    m->nattrs++;
+    return a;
 }
 
 int cdl_mesh_sphere(cdl_mesh *m, double r, int flip, const char *file, int line, cdl_error *err)
@@ -176,6 +199,15 @@ int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int 
     uint32_t first = 0;
     if (!rc)
         rc = cdl_error_place(err, cdl_scene_add_vertices(s, m->nverts, p, n, m->uv, &first, err), s->path, file, line);
+    /* the scene triangle of each mesh triangle, for face attributes (not
+     * kept inside a shape group, whose triangles move on closing) */
+    uint32_t *tri_of = NULL;
+    if (!rc && m->nattrs) {
+        if (!(tri_of = malloc(sizeof *tri_of * (m->ntris ? m->ntris : 1))))
+            rc = cdl_error_set(err, CDL_ERR_SYSTEM, file, line, "out of memory");
+        for (uint32_t t = 0; tri_of && t < m->ntris; t++)
+            tri_of[t] = UINT32_MAX;
+    }
     int flip_all = reverse ^ cdl_mat4_swaps_handedness(xf);
     uint8_t flags = (uint8_t)((n ? CDL_TRI_HAS_N : 0) | (m->uv ? CDL_TRI_HAS_UV : 0));
     for (uint32_t t = 0; t < m->ntris && !rc; t++) {
@@ -205,9 +237,15 @@ int cdl_scene_add_mesh(cdl_scene *s, const cdl_mesh *m, const cdl_mat4 *xf, int 
             b = d;
             d = tmp;
         }
+        uint32_t before = s->ntris;
         rc = cdl_error_place(err, cdl_scene_add_triangle(s, first + a, first + b, first + d, mat, emit, flags, err),
                              s->path, file, line);
+        if (tri_of && s->ntris > before && s->open_group < 0)
+            tri_of[t] = before;
     }
+    if (!rc && tri_of)
+        rc = cdl_scene_add_attrs(s, m, first, tri_of, file, line, err);
+    free(tri_of);
     free(p);
     free(n);
     return rc;

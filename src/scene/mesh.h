@@ -10,12 +10,24 @@
 #include "core/transform.h"
 #include "scene/scene.h"
 
+/* A named per-vertex or per-triangle attribute (Mitsuba's mesh
+ * attributes: "vertex_color", "face_weight"), read by mesh_attribute
+ * textures. */
+typedef struct cdl_mesh_attr {
+    char name[CDL_ATTR_NAME];
+    int per_face; /* one value per triangle, else per vertex */
+    int dim;      /* 1 or 3 floats per value */
+    float *data;
+} cdl_mesh_attr;
+
 typedef struct cdl_mesh {
     uint32_t nverts, ntris;
     float *pos;    /* 3 per vertex */
     float *nrm;    /* 3 per vertex, or NULL */
     float *uv;     /* 2 per vertex, or NULL */
     uint32_t *idx; /* 3 per triangle, each < nverts */
+    cdl_mesh_attr *attrs;
+    int nattrs;
 } cdl_mesh;
 
 /* Allocates the arrays (nrm, uv only when asked); errors name file:line. */
@@ -23,6 +35,9 @@ int cdl_mesh_alloc(cdl_mesh *m, uint32_t nverts, uint32_t ntris, int has_n, int 
                    int line, cdl_error *err);
 /* Frees the arrays and zeroes m; safe on a zeroed or freed mesh. */
 void cdl_mesh_free(cdl_mesh *m);
+/* Appends an attribute of n * dim zeroed floats (n = ntris or nverts);
+ * returns it, or NULL when out of memory. */
+cdl_mesh_attr *cdl_mesh_add_attr(cdl_mesh *m, const char *name, int per_face, int dim);
 
 /* A sphere of radius r about the origin, normals outwards (inwards when
  * flip), pbrt's (u, v): for spheres a transform cannot keep analytic. */
@@ -38,7 +53,8 @@ int cdl_mesh_disk(cdl_mesh *m, double h, double r, double ri, double phimax, int
 int cdl_mesh_cylinder(cdl_mesh *m, double r, double zmin, double zmax, double phimax, int nseg, const char *file,
                       int line, cdl_error *err);
 
-/* Adds m transformed by xf with pbrt-v3's orientation rule: a triangle
+/* Adds m transformed by xf with pbrt-v3's orientation rule (its attributes
+ * with it, see cdl_scene_attr): a triangle
  * faces its shading normals when the mesh has them, otherwise its CCW
  * normal flipped by reverse XOR a handedness-swapping xf. Errors (a
  * singular xf, vertices beyond CDL_MAX_COORD) name file:line. */

@@ -7,6 +7,7 @@
 
 #include "core/grow.h"
 #include "core/log.h"
+#include "scene/attr.h"
 #include "scene/shading.h"
 #include "scene/instance.h"
 
@@ -53,6 +54,7 @@ void cdl_scene_free(cdl_scene *s)
     free(s->face_n);
     free(s->tri_light);
     free(s->mats);
+    cdl_attrs_free(s);
     for (uint32_t i = 0; i < s->ntexs; i++)
         cdl_texture_free(&s->texs[i]);
     free(s->texs);
@@ -144,6 +146,12 @@ int cdl_scene_add_material(cdl_scene *s, const cdl_material *m, uint32_t *id, cd
     for (int k = 0; k < 4 && mm->on; k++)
         if (refs[k] < -1 || refs[k] >= (int)s->ntexs)
             return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "material texture %d out of range", refs[k]);
+    /* a blend's materials come first, so resolving one always ends */
+    if (m->type == CDL_MAT_BLEND &&
+        (m->blend[0] < 0 || m->blend[1] < 0 || m->blend[0] >= (int)s->nmats || m->blend[1] >= (int)s->nmats ||
+         m->blend_tex < -1 || m->blend_tex >= (int)s->ntexs || m->blend_as < -1 || m->blend_as >= (int)s->nmats ||
+         (m->blend_as >= 0 && s->mats[m->blend_as].type == CDL_MAT_BLEND)))
+        return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "blend material refers to a missing material");
     if (cdl_grow((void **)&s->mats, &s->cap_mats, s->nmats + 1, sizeof *m))
         return cdl_error_set(err, CDL_ERR_SYSTEM, s->path, 0, "out of memory for materials");
     s->mats[s->nmats] = cdl_material_canonical(*m);
@@ -487,6 +495,7 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
         hi = cdl_v3(fmaxf(hi.x, q[0] + q[3]), fmaxf(hi.y, q[1] + q[3]), fmaxf(hi.z, q[2] + q[3]));
     }
     cdl_instances_bounds(s, &lo, &hi);
+    cdl_attrs_commit(s);
     s->bmin = lo;
     s->bmax = hi;
     s->eps = 1e-6f * cdl_max3(cdl_sub(hi, lo));
@@ -540,7 +549,9 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
     struct RTCRay rays[CHUNK];
     cdl_shadow_ctx sc;
     rtcInitIntersectContext(&sc.ctx);
-    sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    /* coherent streams through Embree 3's instances can take minutes (seen
+     * in splat's packets and gkde's links): incoherent there */
+    sc.ctx.flags = s->ninsts ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     sc.skip_sphere = skip_sphere;
     for (uint32_t base = 0; base < n; base += CHUNK) {
         uint32_t m = n - base < CHUNK ? n - base : CHUNK;
@@ -651,6 +662,7 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
         sf->light = s->tri_light[h->prim];
     }
     sf->prim = h->prim;
+    cdl_surface_material(s, h, sf);
     cdl_surface_shade(s, sf, cdl_neg(h->d));
 }
 
@@ -658,7 +670,9 @@ void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
 {
     const cdl_material *m = &s->mats[sf->mat];
     cdl_vec3 kd = m->kd;
-    if (m->kd_tex >= 0)
+    if (m->hit_kd)
+        kd = cdl_mul(kd, sf->kdh);
+    else if (m->kd_tex >= 0)
         kd = cdl_mul(kd, cdl_texture_eval(s->texs, m->kd_tex, sf->u, sf->v));
     cdl_bsdf_init(b, m, kd, sf->ns, sf->ng);
     if (m->masked && m->opacity_tex >= 0)

@@ -64,6 +64,7 @@ typedef struct cdl_scene_settings {
 
 
 typedef struct cdl_group cdl_group;       /* scene/instance.h */
+typedef struct cdl_attr cdl_attr;         /* scene/attr.h */
 typedef struct cdl_instance cdl_instance;
 
 /* Also the public API's scene handle (candela.h). */
@@ -105,6 +106,8 @@ typedef struct cdl_scene {
     uint32_t nmats, cap_mats;
     cdl_texture *texs;
     uint32_t ntexs, cap_texs;
+    cdl_attr *attrs;   /* mesh attributes the textures read (scene/attr.h) */
+    uint32_t nattrs, cap_attrs;
     cdl_light *lights;
     uint32_t nlights, cap_lights;
     cdl_alias light_select;
@@ -181,6 +184,7 @@ typedef struct cdl_surface {
     float u, v;
     uint32_t prim, geom, mat;
     int32_t light;      /* index of the area light on this shape, or -1 */
+    cdl_vec3 kdh;       /* reflectance factor decided at the hit (material hit_kd; scene/attr.h) */
 } cdl_surface;
 
 static inline struct RTCIntersectContext cdl_context(void)

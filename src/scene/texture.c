@@ -24,6 +24,7 @@ void cdl_texture_init(cdl_texture *t, cdl_tex_type type)
     t->a = t->b = cdl_v3(1.0f, 1.0f, 1.0f);
     t->sub[0] = t->sub[1] = -1;
     t->scale = 1.0f;
+    t->attr_key = -1;
 }
 
 int cdl_texture_load_image(cdl_texture *t, const char *path, int raw, cdl_error *err)

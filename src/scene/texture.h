@@ -16,8 +16,11 @@ typedef enum cdl_tex_type {
     CDL_TEX_BITMAP,  /* an image */
     CDL_TEX_CHECKER, /* Mitsuba's checkerboard of a (color0) and b (color1) */
     CDL_TEX_CONST,   /* the constant a */
-    CDL_TEX_SCALE    /* sub-texture sub[0] (or a) times scale */
+    CDL_TEX_SCALE,   /* sub-texture sub[0] (or a) times scale */
+    CDL_TEX_ATTRIBUTE /* Mitsuba's mesh_attribute `attr`: read at a hit (scene/attr.h), not at a uv */
 } cdl_tex_type;
+
+#define CDL_ATTR_NAME 48 /* longest attribute name + 1 */
 
 typedef enum cdl_tex_wrap { CDL_WRAP_REPEAT, CDL_WRAP_MIRROR, CDL_WRAP_CLAMP } cdl_tex_wrap;
 
@@ -32,6 +35,8 @@ typedef struct cdl_texture {
     cdl_vec3 a, b;   /* checker colors, constant, scale operand */
     int sub[2];      /* checker: textures for a and b (-1: the constants); scale: sub[0] */
     float scale;
+    char attr[CDL_ATTR_NAME]; /* attribute: its name */
+    int attr_key;             /* and the scene's attribute of that name, or -1 (after commit) */
 } cdl_texture;
 
 /* An OBJ/pbrt image texture (repeating, bilinear, sRGB decoded). */

@@ -51,6 +51,7 @@ static uint32_t push(cdl_vertex_store *vs)
     vs->pdf_rev[i] = 0.0f;
     vs->rr[i] = 1.0f;
     vs->u[i] = vs->v[i] = 0.0f;
+    vs->kdh[i] = cdl_v3(1.0f, 1.0f, 1.0f);
     vs->ts[i] = vs->nb[i] = cdl_v3(0.0f, 0.0f, 0.0f);
     vs->mat[i] = 0;
     return i;
@@ -101,6 +102,7 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
                                                              : cdl_pdf_to_area(pdf_dir, vs->p[prev], sf.p, sf.ng);
         vs->u[i] = sf.u;
         vs->v[i] = sf.v;
+        vs->kdh[i] = sf.kdh;
         vs->ts[i] = sf.ts;
         vs->nb[i] = sf.nb;
         vs->parent[i] = (int32_t)prev;

@@ -6,7 +6,7 @@
 void cdl_vs_init(cdl_vertex_store *vs) { memset(vs, 0, sizeof *vs); }
 
 #define VS_FIELDS(X)                                                                               \
-    X(p) X(ns) X(ng) X(ts) X(nb) X(wi) X(beta) X(pdf_fwd) X(pdf_rev) X(rr) X(u) X(v) X(parent) X(mat) X(light) \
+    X(p) X(ns) X(ng) X(ts) X(nb) X(wi) X(beta) X(pdf_fwd) X(pdf_rev) X(rr) X(u) X(v) X(kdh) X(parent) X(mat) X(light) \
     X(depth) X(flags)
 
 void cdl_vs_free(cdl_vertex_store *vs)
@@ -80,6 +80,7 @@ void cdl_vs_bsdf(const cdl_scene *s, const cdl_vertex_store *vs, uint32_t i, cdl
     sf.nb = cdl_is_black(vs->nb[i]) ? sf.ns : vs->nb[i];
     sf.u = vs->u[i];
     sf.v = vs->v[i];
+    sf.kdh = vs->kdh[i];
     sf.mat = vs->mat[i];
     sf.prim = 0;
     sf.geom = 0;

@@ -34,6 +34,7 @@ typedef struct cdl_vertex_store {
                               roulette; 1 without): a method that uses the successor's
                               existence (gkde's footprints) divides by it */
     float *u, *v;          /* texture coordinates (to rebuild the BSDF) */
+    cdl_vec3 *kdh;         /* the reflectance factor the hit decided (cdl_surface's) */
     int32_t *parent;       /* previous vertex of the same path, -1 at the start */
     uint32_t *mat;
     int32_t *light;        /* light a light path started on / an eye vertex lies on, or -1 */
