@@ -2,7 +2,9 @@
  * bitmap lookups at known texels with each wrap and filter mode, the
  * checkerboard's two conventions, the bilinear gradient, a bump map of a
  * linear height field tilting the normal by the analytic angle, and an
- * identity normal map leaving the BSDF unchanged. */
+ * identity normal map leaving the BSDF unchanged. Then pbrt's: its
+ * checkerboard cells, black wrap, products and mixes of textures with
+ * their gradients. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -195,12 +197,82 @@ static void identity_normal_map(void)
           "the anisotropic lobe is oriented by the tangent");
 }
 
+/* pbrt's checkerboard: tex1 where floor(s) + floor(t) is even, for the
+ * colour and the scalar alike, negative cells included; t is v itself. */
+static void pbrt_checker(void)
+{
+    cdl_texture t;
+    cdl_texture_init(&t, CDL_TEX_CHECKER);
+    t.unit_cells = 1;
+    t.m[0] = 2.0f, t.m[1] = 0.0f, t.m[2] = 0.0f; /* s = 2 u, t = 2 v */
+    t.m[3] = 0.0f, t.m[4] = 2.0f, t.m[5] = 0.0f;
+    t.a = cdl_v3(0.25f, 0.25f, 0.25f);
+    t.b = cdl_v3(0.75f, 0.75f, 0.75f);
+    static const struct {
+        float u, v;
+        int first;
+    } at[] = {{0.1f, 0.1f, 1}, {0.6f, 0.1f, 0}, {0.6f, 0.6f, 1}, {0.1f, 0.6f, 0},
+              {-0.1f, 0.1f, 0}, {-0.1f, -0.1f, 1}, {-0.6f, 0.1f, 1}, {1.0f, 0.1f, 1}};
+    int bad = 0;
+    for (size_t i = 0; i < sizeof at / sizeof at[0]; i++) {
+        float want = at[i].first ? 0.25f : 0.75f;
+        float c = cdl_texture_eval(&t, 0, at[i].u, at[i].v).x, f = cdl_texture_eval1(&t, 0, at[i].u, at[i].v);
+        if (c != want || f != want) {
+            printf("      (u, v) = (%g, %g): colour %g, scalar %g, want %g\n", (double)at[i].u, (double)at[i].v,
+                   (double)c, (double)f, (double)want);
+            bad++;
+        }
+    }
+    CHECK(bad == 0, "pbrt checkerboard: tex1 where floor(2u) + floor(2v) is even, colour and scalar, at %zu points",
+          sizeof at / sizeof at[0]);
+}
+
+/* pbrt's black wrap, the product of two textures and a mix, with their
+ * gradients by the product rule. */
+static void pbrt_combinations(void)
+{
+    cdl_texture texs[5];
+    texs[0] = grey(8, 8, ramp); /* 0.8 u (+ const) along u */
+    texs[0].wrap = CDL_WRAP_BLACK;
+    float in = cdl_texture_eval(texs, 0, 0.5f / 8.0f, 0.5f).x, edge = cdl_texture_eval(texs, 0, 0.0f, 0.5f).x,
+          out = cdl_texture_eval(texs, 0, -0.5f, 0.5f).x, right = cdl_texture_eval(texs, 0, 1.0f, 0.5f).x;
+    CHECK(in == 0.0f && edge == 0.0f && out == 0.0f && fabsf(right - 0.35f) < 1e-6f,
+          "black wrap: texel 0 %g, left edge %g, outside %g, right edge %g (half of texel 7's 0.7)", (double)in,
+          (double)edge, (double)out, (double)right);
+    texs[0].wrap = CDL_WRAP_REPEAT;
+    cdl_texture_init(&texs[1], CDL_TEX_CONST);
+    texs[1].a = cdl_v3(0.5f, 0.5f, 0.5f);
+    /* 2: ramp * ramp * 2; 3: mix of the ramp and 0.5 by the ramp */
+    cdl_texture_init(&texs[2], CDL_TEX_SCALE);
+    texs[2].sub[0] = texs[2].sub[1] = 0;
+    texs[2].scale = 2.0f;
+    cdl_texture_init(&texs[3], CDL_TEX_MIX);
+    texs[3].sub[0] = 0;
+    texs[3].sub[1] = 1;
+    texs[3].amount_tex = 0;
+    float u = 0.5f, v = 0.5f, h = cdl_texture_eval1(texs, 0, u, v), g[2];
+    float p = cdl_texture_eval(texs, 2, u, v).x, p1 = cdl_texture_eval1(texs, 2, u, v);
+    cdl_texture_grad1(texs, 2, u, v, g);
+    CHECK(fabsf(p - 2.0f * h * h) < 1e-5f && fabsf(p1 - p) < 1e-5f && fabsf(g[0] - 4.0f * h * 0.8f) < 1e-4f &&
+              fabsf(g[1]) < 1e-6f,
+          "scale of two textures: %g (2 h^2 = %g), gradient %g (4 h h' = %g)", (double)p, (double)(2.0f * h * h),
+          (double)g[0], (double)(4.0f * h * 0.8f));
+    float mx = cdl_texture_eval(texs, 3, u, v).x, m1 = cdl_texture_eval1(texs, 3, u, v);
+    cdl_texture_grad1(texs, 3, u, v, g);
+    float want = (1.0f - h) * h + h * 0.5f, dwant = (1.0f - 2.0f * h + 0.5f) * 0.8f;
+    CHECK(fabsf(mx - want) < 1e-5f && fabsf(m1 - want) < 1e-5f && fabsf(g[0] - dwant) < 1e-4f,
+          "mix by a texture: %g (%g), gradient %g (%g)", (double)mx, (double)want, (double)g[0], (double)dwant);
+    cdl_texture_free(&texs[0]);
+}
+
 int main(void)
 {
     lookups();
     checker();
     bump();
     identity_normal_map();
+    pbrt_checker();
+    pbrt_combinations();
     if (test_failures)
         printf("%d check(s) failed\n", test_failures);
     return test_failures != 0;
