@@ -4,7 +4,8 @@
  * linear height field tilting the normal by the analytic angle, and an
  * identity normal map leaving the BSDF unchanged. Then pbrt's: its
  * checkerboard cells, black wrap, products and mixes of textures with
- * their gradients. */
+ * their gradients, the bump frames of its meshes with vertex normals and
+ * textured roughness remapped at each lookup. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -265,6 +266,86 @@ static void pbrt_combinations(void)
     cdl_texture_free(&texs[0]);
 }
 
+/* pbrt's bump frames on meshes with vertex normals: v3 displaces its
+ * unit, reversed shading frame (the tilt has the other sign and ignores
+ * |dp/du|), v4 its shading frame of |dp/du|'s length. A height h = 0.4 u
+ * over a plane where dp/du = (2, 0, 0), dp/dv = (0, 1, 0). */
+static void pbrt_bump_frames(void)
+{
+    cdl_texture texs[1] = {grey(8, 8, ramp)};
+    cdl_material m[3];
+    for (int i = 0; i < 3; i++) {
+        m[i] = cdl_material_default(CDL_MAT_DIFFUSE);
+        m[i].maps.on = 1;
+        m[i].maps.bump_tex = 0;
+        m[i].maps.bump_scale = 0.5f;
+        m[i].maps.bump_frame = i; /* PARTIALS, PBRT3_VN, PBRT4_VN */
+    }
+    cdl_scene s;
+    memset(&s, 0, sizeof s);
+    s.mats = m;
+    s.nmats = 3;
+    s.texs = texs;
+    s.ntexs = 1;
+    float tilt[3];
+    for (int i = 0; i < 3; i++) {
+        cdl_surface sf = plane((uint32_t)i);
+        sf.dpdu = cdl_v3(2, 0, 0);
+        cdl_surface_shade(&s, &sf, cdl_v3(0, 0, 1));
+        tilt[i] = atan2f(-sf.ns.x, sf.ns.z); /* towards -x positive */
+    }
+    CHECK(fabsf(tilt[0] - atanf(0.2f)) < 1e-4f && fabsf(tilt[1] + atanf(0.4f)) < 1e-4f &&
+              fabsf(tilt[2] - atanf(0.2f)) < 1e-4f,
+          "bump tilt towards -x: partials %g (atan 0.2 = %g), pbrt-v3 with normals %g (-atan 0.4 = %g), pbrt-v4 %g",
+          (double)tilt[0], (double)atanf(0.2f), (double)tilt[1], (double)-atanf(0.4f), (double)tilt[2]);
+    /* a ramp along v (h = 0.4 v) tells v4's frame (|dp/du| t) from the partials (dp/dv) */
+    texs[0].m[0] = 0.0f, texs[0].m[1] = 1.0f, texs[0].m[2] = 0.0f; /* s = v */
+    for (int i = 0; i < 3; i += 2) {
+        cdl_surface sf = plane((uint32_t)i);
+        sf.dpdu = cdl_v3(2, 0, 0);
+        cdl_surface_shade(&s, &sf, cdl_v3(0, 0, 1));
+        tilt[i] = atan2f(-sf.ns.y, sf.ns.z);
+    }
+    CHECK(fabsf(tilt[0] - atanf(0.4f)) < 1e-4f && fabsf(tilt[2] - atanf(0.2f)) < 1e-4f,
+          "bump along v: partials %g (atan 0.4 = %g), pbrt-v4 with normals %g (atan 0.2 = %g)", (double)tilt[0],
+          (double)atanf(0.4f), (double)tilt[2], (double)atanf(0.2f));
+    cdl_texture_free(&texs[0]);
+}
+
+/* A textured roughness becomes alpha at each lookup as pbrt remaps it. */
+static void pbrt_roughness(void)
+{
+    cdl_texture texs[1];
+    cdl_texture_init(&texs[0], CDL_TEX_CONST);
+    texs[0].a = cdl_v3(0.25f, 0.25f, 0.25f);
+    cdl_material m[2];
+    for (int i = 0; i < 2; i++) {
+        m[i] = cdl_material_default(CDL_MAT_CONDUCTOR);
+        m[i].maps.on = 1;
+        m[i].maps.alpha_tex[0] = m[i].maps.alpha_tex[1] = 0;
+        m[i].maps.alpha_remap = i ? CDL_ROUGH_PBRT4 : CDL_ROUGH_PBRT3;
+    }
+    cdl_scene s;
+    memset(&s, 0, sizeof s);
+    s.mats = m;
+    s.nmats = 2;
+    s.texs = texs;
+    s.ntexs = 1;
+    float a[2];
+    for (int i = 0; i < 2; i++) {
+        cdl_surface sf = plane((uint32_t)i);
+        cdl_surface_shade(&s, &sf, cdl_v3(0, 0, 1));
+        cdl_bsdf b;
+        cdl_scene_bsdf(&s, &sf, &b);
+        a[i] = b.ax;
+    }
+    float x = logf(0.25f);
+    float v3 = 1.62142f + 0.819955f * x + 0.1734f * x * x + 0.0171201f * x * x * x + 0.000640711f * x * x * x * x;
+    CHECK(fabsf(a[0] - v3) < 1e-5f && fabsf(a[1] - 0.5f) < 1e-6f,
+          "textured roughness 0.25: pbrt-v3 alpha %g (%g), pbrt-v4 %g (sqrt: 0.5)", (double)a[0], (double)v3,
+          (double)a[1]);
+}
+
 int main(void)
 {
     lookups();
@@ -273,6 +354,8 @@ int main(void)
     identity_normal_map();
     pbrt_checker();
     pbrt_combinations();
+    pbrt_bump_frames();
+    pbrt_roughness();
     if (test_failures)
         printf("%d check(s) failed\n", test_failures);
     return test_failures != 0;
