@@ -158,6 +158,8 @@ static int maps(cdl_pbrt_ctx *c, cdl_material *m)
     cdl_pbrt_param *nm = cdl_pbrt_find(&c->ps, "normalmap"), *d = cdl_pbrt_find(&c->ps, "displacement");
     cdl_pbrt_param *b = cdl_pbrt_find(&c->ps, "bumpmap");
     int rc, tex = -1;
+    if (nm && nm->type == CDL_PT_STRING && nm->n == 1 && !*cdl_pbrt_str(&c->ps, nm, 0))
+        nm = NULL; /* pbrt-v4's "no normal map" */
     if (nm) {
         if ((rc = cdl_pbrt_normal_map(c, nm, &tex)))
             return rc;
