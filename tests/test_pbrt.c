@@ -1,5 +1,6 @@
 /* pbrt reader: transforms, camera frame, Include, instancing, orientation
  * of emitting triangles and spheres, materials; then the real scenes.
+ * Textures: test_pbrt_textures.c.
  *
  *   test_pbrt [SHARED_SCENES_DIR]
  *

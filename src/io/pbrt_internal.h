@@ -1,7 +1,7 @@
 /* State shared by the parts of the pbrt reader: pbrt_loader.c (directives,
  * graphics state, camera and settings), pbrt_lights.c, pbrt_shapes.c
- * (shapes, instancing) and pbrt_materials.c (materials, textures). Not a
- * public interface. */
+ * (shapes, instancing), pbrt_materials.c (materials) and pbrt_textures.c
+ * (textures). Not a public interface. */
 #ifndef CDL_PBRT_INTERNAL_H
 #define CDL_PBRT_INTERNAL_H
 
@@ -35,6 +35,7 @@ typedef struct cdl_pbrt_gstate {
 
 typedef struct cdl_pbrt_shape {
     int sphere;     /* 1: analytic sphere of this radius; 0: mesh */
+    int quads;      /* the mesh's triangles are bilinear patches split in two */
     double radius;
     cdl_mesh mesh; /* in object space, validated */
 } cdl_pbrt_shape;
@@ -44,16 +45,25 @@ typedef struct cdl_pbrt_object {
     uint32_t group; /* the scene's shape group */
 } cdl_pbrt_object;
 
-typedef enum cdl_pbrt_tex_kind { CDL_PBRT_TEX_CONST, CDL_PBRT_TEX_IMAGE, CDL_PBRT_TEX_OTHER } cdl_pbrt_tex_kind;
+/* A pbrt texture: a constant, a scene texture that evaluates to pbrt's
+ * value, or a class candela lacks (its definition warned). */
+typedef enum cdl_pbrt_tex_kind { CDL_PBRT_TEX_CONST, CDL_PBRT_TEX_SCENE, CDL_PBRT_TEX_OTHER } cdl_pbrt_tex_kind;
 
 typedef struct cdl_pbrt_tex {
     char *name;
     int is_float;
     cdl_pbrt_tex_kind kind;
-    cdl_vec3 value; /* constant value, or the image's scale */
-    int tex_id;     /* scene texture of an image (spectrum textures), else -1 */
-    char *path;     /* image file (for sharing one decoded copy) */
+    cdl_vec3 value; /* CONST: the value; SCENE: its mean (for parameters that take only
+                     * constants); OTHER: the grey that stands for it */
+    int tex_id;     /* SCENE: the scene texture, else -1 */
 } cdl_pbrt_tex;
+
+/* One scene copy of an image per distinct use (file, decoding, mapping). */
+typedef struct cdl_pbrt_image {
+    char *key;
+    int tex_id;
+    cdl_vec3 mean;
+} cdl_pbrt_image;
 
 typedef struct cdl_pbrt_named {
     char *name;
@@ -86,6 +96,10 @@ typedef struct cdl_pbrt_ctx {
     int nnamed, capnamed;
     cdl_pbrt_tex *texs;
     int ntexs, captexs;
+    cdl_pbrt_image *imgs;
+    int nimgs, capimgs;
+    int32_t *variants;         /* pairs (material, its variant displacing the partials) */
+    int nvariants, capvariants;
     cdl_pbrt_coordsys *cs;
     int ncs, capcs;
     cdl_pbrt_object *objs;
@@ -124,8 +138,19 @@ int cdl_pbrt_area_light(cdl_pbrt_ctx *c, const char *type);
 /* Makes the scene material of a Material / MakeNamedMaterial directive;
  * *mat may come back as CDL_PBRT_MAT_NONE. */
 int cdl_pbrt_material(cdl_pbrt_ctx *c, const char *type, const char *name, int32_t *mat);
-int cdl_pbrt_texture(cdl_pbrt_ctx *c, const char *name, const char *type, const char *cls);
 /* The current material, creating pbrt's default on first use. */
 int cdl_pbrt_current_material(cdl_pbrt_ctx *c, int32_t *mat);
+/* The material a shape uses: mat itself, or its variant whose bump map
+ * displaces pbrt's shading frame of meshes with vertex normals
+ * (cdl_bump_frame) when vnormals, else the surface partials. */
+int cdl_pbrt_shape_material(cdl_pbrt_ctx *c, uint32_t mat, int vnormals, uint32_t *out);
+
+/* pbrt_textures.c */
+int cdl_pbrt_texture(cdl_pbrt_ctx *c, const char *name, const char *type, const char *cls);
+/* The texture a "texture" parameter names (its type's table first). */
+int cdl_pbrt_texture_ref(cdl_pbrt_ctx *c, const cdl_pbrt_param *p, int is_float, const cdl_pbrt_tex **out);
+/* pbrt-v4's "string normalmap": the image as a scene texture. */
+int cdl_pbrt_normal_map(cdl_pbrt_ctx *c, const cdl_pbrt_param *p, int *tex);
+void cdl_pbrt_textures_free(cdl_pbrt_ctx *c);
 
 #endif

@@ -645,11 +645,8 @@ static void ctx_free(cdl_pbrt_ctx *c)
     for (int i = 0; i < c->nnamed; i++)
         free(c->named[i].name);
     free(c->named);
-    for (int i = 0; i < c->ntexs; i++) {
-        free(c->texs[i].name);
-        free(c->texs[i].path);
-    }
-    free(c->texs);
+    cdl_pbrt_textures_free(c);
+    free(c->variants);
     for (int i = 0; i < c->ncs; i++)
         free(c->cs[i].name);
     free(c->cs);

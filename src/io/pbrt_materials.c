@@ -1,4 +1,4 @@
-/* pbrt materials and textures mapped onto candela's material models.
+/* pbrt materials mapped onto candela's material models.
  * Defaults, parameter names and the roughness remapping are pbrt's:
  * v3 (matte, plastic, metal, mirror, glass, uber) and v4 (diffuse,
  * conductor, dielectric, coateddiffuse) names tell the versions apart. */
@@ -29,31 +29,9 @@ int cdl_pbrt_current_material(cdl_pbrt_ctx *c, int32_t *mat)
     return 0;
 }
 
-static const cdl_pbrt_tex *find_tex(const cdl_pbrt_ctx *c, const char *name, int is_float)
-{
-    for (int i = c->ntexs; i-- > 0;)
-        if (c->texs[i].is_float == is_float && !strcmp(c->texs[i].name, name))
-            return &c->texs[i];
-    return NULL;
-}
-
-static const cdl_pbrt_tex *texture_ref(cdl_pbrt_ctx *c, const cdl_pbrt_param *p, int is_float)
-{
-    const char *name = p->n == 1 ? cdl_pbrt_str(&c->ps, p, 0) : "";
-    const cdl_pbrt_tex *t = find_tex(c, name, is_float);
-    return t ? t : find_tex(c, name, !is_float);
-}
-
-static int undefined_tex(cdl_pbrt_ctx *c, const cdl_pbrt_param *p)
-{
-    if (p->n != 1)
-        return cdl_pbrt_error(c, p->line, "parameter \"texture %s\" expects one texture name", p->name);
-    return cdl_pbrt_error(c, p->line, "texture \"%s\" (for \"%s\") is not defined",
-                          cdl_pbrt_str(&c->ps, p, 0), p->name);
-}
-
 /* A spectrum parameter of a material, possibly a texture reference;
- * image textures go to *tex when the caller can use them (Kd). */
+ * textures go to *tex when the caller can use them (Kd), else their mean
+ * stands for them, with a warning. */
 static int mat_spectrum(cdl_pbrt_ctx *c, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex, int *found)
 {
     cdl_pbrt_param *p = cdl_pbrt_find(&c->ps, name);
@@ -66,20 +44,16 @@ static int mat_spectrum(cdl_pbrt_ctx *c, const char *name, cdl_vec3 def, cdl_vec
         return 0;
     int rc = 0;
     if (p->type == CDL_PT_TEXTURE) {
-        const cdl_pbrt_tex *t = texture_ref(c, p, 0);
-        if (!t)
-            return undefined_tex(c, p);
-        if (t->kind == CDL_PBRT_TEX_CONST) {
-            *out = t->value;
-        } else if (t->kind == CDL_PBRT_TEX_IMAGE && tex && t->tex_id >= 0) {
+        const cdl_pbrt_tex *t;
+        if ((rc = cdl_pbrt_texture_ref(c, p, 0, &t)))
+            return rc;
+        *out = t->value;
+        if (t->kind == CDL_PBRT_TEX_SCENE && tex) {
             *tex = t->tex_id;
-            *out = t->value;
-        } else if (t->kind == CDL_PBRT_TEX_IMAGE) {
-            cdl_pbrt_warn(c, p->line, "image texture \"%s\" for \"%s\" is not supported: the default is used",
-                          t->name, name);
-        } else {
-            cdl_pbrt_warn(c, p->line, "texture \"%s\" for \"%s\" approximated by grey 0.5", t->name, name);
-            *out = cdl_v3(0.5f, 0.5f, 0.5f);
+            *out = cdl_v3(1, 1, 1);
+        } else if (t->kind == CDL_PBRT_TEX_SCENE) {
+            cdl_pbrt_warn(c, p->line, "texture \"%s\" for \"%s\" is not supported: its mean (%g %g %g) is used",
+                          t->name, name, (double)out->x, (double)out->y, (double)out->z);
         }
     } else {
         rc = cdl_pbrt_param_spectrum(&c->ps, p, out, c->err);
@@ -90,23 +64,28 @@ static int mat_spectrum(cdl_pbrt_ctx *c, const char *name, cdl_vec3 def, cdl_vec
     return rc;
 }
 
-/* A float parameter; textures only as constants. Spectra (a v4 "eta")
- * are averaged. */
-static int mat_float(cdl_pbrt_ctx *c, const char *name, double def, double *out)
+/* A float parameter, possibly a texture: to *tex when the caller can use
+ * it (roughness), else its mean with a warning. Spectra (a v4 "eta") are
+ * averaged. */
+static int mat_float_tex(cdl_pbrt_ctx *c, const char *name, double def, double *out, int *tex)
 {
     cdl_pbrt_param *p = cdl_pbrt_find(&c->ps, name);
     *out = def;
+    if (tex)
+        *tex = -1;
     if (!p)
         return 0;
     if (p->type == CDL_PT_TEXTURE) {
-        const cdl_pbrt_tex *t = texture_ref(c, p, 1);
-        if (!t)
-            return undefined_tex(c, p);
-        if (t->kind == CDL_PBRT_TEX_CONST)
-            *out = (t->value.x + t->value.y + t->value.z) / 3.0;
-        else
-            cdl_pbrt_warn(c, p->line, "texture \"%s\" for \"%s\" is not a constant: the default %g is used",
-                          t->name, name, def);
+        const cdl_pbrt_tex *t;
+        int rc = cdl_pbrt_texture_ref(c, p, 1, &t);
+        if (rc)
+            return rc;
+        *out = (t->value.x + t->value.y + t->value.z) / 3.0;
+        if (t->kind == CDL_PBRT_TEX_SCENE && tex)
+            *tex = t->tex_id;
+        else if (t->kind == CDL_PBRT_TEX_SCENE)
+            cdl_pbrt_warn(c, p->line, "texture \"%s\" for \"%s\" is not supported: its mean %g is used", t->name,
+                          name, *out);
         return 0;
     }
     if (p->type == CDL_PT_FLOAT || p->type == CDL_PT_INT) {
@@ -122,35 +101,40 @@ static int mat_float(cdl_pbrt_ctx *c, const char *name, double def, double *out)
     return rc;
 }
 
-/* pbrt-v3 TrowbridgeReitzDistribution::RoughnessToAlpha; pbrt-v4 uses
- * sqrt(roughness). */
-static float rough_to_alpha(double r, int remap, int v4)
+static int mat_float(cdl_pbrt_ctx *c, const char *name, double def, double *out)
 {
-    if (!remap)
-        return (float)r;
-    if (v4)
-        return (float)sqrt(r);
-    double x = log(r > 1e-3 ? r : 1e-3);
-    return (float)(1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x * x * x +
-                   0.000640711 * x * x * x * x);
+    return mat_float_tex(c, name, def, out, NULL);
 }
 
 /* roughness / uroughness / vroughness / remaproughness into alpha;
- * *smooth tells whether both raw roughnesses are 0 (pbrt's specular case). */
+ * *smooth tells whether both raw roughnesses are 0 (pbrt's specular
+ * case). Float textures become alpha textures, remapped at each lookup
+ * as pbrt does (v3's RoughnessToAlpha, v4's sqrt). */
 static int roughness(cdl_pbrt_ctx *c, double def, int v4, cdl_material *m, int *smooth)
 {
     double r, u, v;
-    int remap, rc;
-    if ((rc = mat_float(c, "roughness", def, &r)) || (rc = mat_float(c, "uroughness", r, &u)) ||
-        (rc = mat_float(c, "vroughness", r, &v)) ||
+    int remap, rc, rt, ut, vt;
+    if ((rc = mat_float_tex(c, "roughness", def, &r, &rt)) || (rc = mat_float_tex(c, "uroughness", r, &u, &ut)) ||
+        (rc = mat_float_tex(c, "vroughness", r, &v, &vt)) ||
         (rc = cdl_pbrt_get_bool(&c->ps, "remaproughness", 1, &remap, c->err)))
         return rc;
+    if (!cdl_pbrt_find(&c->ps, "uroughness"))
+        ut = rt;
+    if (!cdl_pbrt_find(&c->ps, "vroughness"))
+        vt = rt;
     if (!(u >= 0.0 && v >= 0.0))
         return cdl_pbrt_error(c, c->line, "roughness (%g, %g) must be >= 0", u, v);
-    m->alpha_x = rough_to_alpha(u, remap, v4);
-    m->alpha_y = rough_to_alpha(v, remap, v4);
+    int mode = !remap ? CDL_ROUGH_ALPHA : v4 ? CDL_ROUGH_PBRT4 : CDL_ROUGH_PBRT3;
+    m->alpha_x = cdl_roughness_to_alpha(u, mode);
+    m->alpha_y = cdl_roughness_to_alpha(v, mode);
     if (smooth)
-        *smooth = u == 0.0 && v == 0.0;
+        *smooth = u == 0.0 && v == 0.0 && ut < 0 && vt < 0;
+    if (ut >= 0 || vt >= 0) {
+        m->maps.on = 1;
+        m->maps.alpha_tex[0] = ut;
+        m->maps.alpha_tex[1] = vt;
+        m->maps.alpha_remap = mode;
+    }
     return 0;
 }
 
@@ -163,6 +147,47 @@ static int eta_param(cdl_pbrt_ctx *c, double *eta)
     if (!rc && !(*eta > 0.0))
         return cdl_pbrt_error(c, c->line, "index of refraction %g must be > 0", *eta);
     return rc;
+}
+
+/* pbrt-v3's "bumpmap" and v4's "displacement": a float texture d, the
+ * surface displaced by d along the shading normal (candela's bump map
+ * with scale 1, cdl_bump_frame); v4's "normalmap" image, which pbrt-v4
+ * prefers to a displacement. */
+static int maps(cdl_pbrt_ctx *c, cdl_material *m)
+{
+    cdl_pbrt_param *nm = cdl_pbrt_find(&c->ps, "normalmap"), *d = cdl_pbrt_find(&c->ps, "displacement");
+    cdl_pbrt_param *b = cdl_pbrt_find(&c->ps, "bumpmap");
+    int rc, tex = -1;
+    if (nm && nm->type == CDL_PT_STRING && nm->n == 1 && !*cdl_pbrt_str(&c->ps, nm, 0))
+        nm = NULL; /* pbrt-v4's "no normal map" */
+    if (nm) {
+        if ((rc = cdl_pbrt_normal_map(c, nm, &tex)))
+            return rc;
+        m->maps.on = 1;
+        m->maps.normal_tex = tex;
+        return 0;
+    }
+    int v4 = d != NULL;
+    cdl_pbrt_param *p = d ? d : b;
+    if (!p)
+        return 0;
+    if (p->type == CDL_PT_FLOAT || p->type == CDL_PT_INT)
+        return 0; /* a constant displacement leaves the normal as it is */
+    if (p->type != CDL_PT_TEXTURE)
+        return cdl_pbrt_error(c, p->line, "parameter \"%s %s\" should be a float texture", p->tname, p->name);
+    const cdl_pbrt_tex *t;
+    if ((rc = cdl_pbrt_texture_ref(c, p, 1, &t)))
+        return rc;
+    if (t->kind == CDL_PBRT_TEX_OTHER)
+        cdl_pbrt_warn(c, p->line, "%s \"%s\" of an unsupported texture class is ignored", p->name, t->name);
+    if (t->kind != CDL_PBRT_TEX_SCENE)
+        return 0;
+    m->maps.on = 1;
+    m->maps.bump_tex = t->tex_id;
+    m->maps.bump_scale = 1.0f;
+    /* shapes without vertex normals take the partials (cdl_pbrt_shape_material) */
+    m->maps.bump_frame = v4 ? CDL_BUMP_PBRT4_VN : CDL_BUMP_PBRT3_VN;
+    return 0;
 }
 
 static int make(cdl_pbrt_ctx *c, const char *type, cdl_material *m)
@@ -256,11 +281,7 @@ static int make(cdl_pbrt_ctx *c, const char *type, cdl_material *m)
     }
     if (rc)
         return rc;
-    const char *bump[] = {"bumpmap", "displacement", "normalmap"};
-    for (size_t i = 0; i < 3; i++)
-        if (cdl_pbrt_find(&c->ps, bump[i]))
-            cdl_pbrt_warn(c, c->line, "material \"%s\": %s ignored", type, bump[i]);
-    return 0;
+    return maps(c, m);
 }
 
 int cdl_pbrt_material(cdl_pbrt_ctx *c, const char *type, const char *name, int32_t *mat)
@@ -277,145 +298,35 @@ int cdl_pbrt_material(cdl_pbrt_ctx *c, const char *type, const char *name, int32
     return 0;
 }
 
-/* ---- textures ---- */
-
-/* An operand of a "scale" texture: a texture reference or a value. */
-static int tex_operand(cdl_pbrt_ctx *c, const char *pname, cdl_pbrt_tex *out)
+int cdl_pbrt_shape_material(cdl_pbrt_ctx *c, uint32_t mat, int vnormals, uint32_t *out)
 {
-    cdl_pbrt_param *p = cdl_pbrt_find(&c->ps, pname);
-    memset(out, 0, sizeof *out);
-    out->kind = CDL_PBRT_TEX_CONST;
-    out->value = cdl_v3(1, 1, 1);
-    out->tex_id = -1;
-    if (!p)
+    *out = mat;
+    const cdl_material *m = &c->s->mats[mat];
+    if (!m->maps.on || m->maps.bump_tex < 0 || m->maps.bump_frame == CDL_BUMP_PARTIALS || vnormals)
         return 0;
-    if (p->type == CDL_PT_TEXTURE) {
-        const cdl_pbrt_tex *t = texture_ref(c, p, 0);
-        if (!t)
-            return undefined_tex(c, p);
-        out->kind = t->kind;
-        out->value = t->value;
-        out->tex_id = t->tex_id;
-        return 0;
-    }
-    return cdl_pbrt_param_spectrum(&c->ps, p, &out->value, c->err);
-}
-
-static int image_texture(cdl_pbrt_ctx *c, int is_float, cdl_pbrt_tex *t)
-{
-    cdl_pbrt_params *ps = &c->ps;
-    const char *fn, *mapping, *wrap, *enc;
-    double sc, us, vs, ud, vd;
-    int inv, gamma, rc;
-    if ((rc = cdl_pbrt_get_string(ps, "filename", NULL, &fn, c->err)) ||
-        (rc = cdl_pbrt_get_float(ps, "scale", 1.0, &sc, c->err)) ||
-        (rc = cdl_pbrt_get_bool(ps, "invert", 0, &inv, c->err)) ||
-        (rc = cdl_pbrt_get_string(ps, "mapping", "uv", &mapping, c->err)) ||
-        (rc = cdl_pbrt_get_string(ps, "wrap", "repeat", &wrap, c->err)) ||
-        (rc = cdl_pbrt_get_string(ps, "encoding", "sRGB", &enc, c->err)) ||
-        (rc = cdl_pbrt_get_bool(ps, "gamma", 1, &gamma, c->err)) ||
-        (rc = cdl_pbrt_get_float(ps, "uscale", 1.0, &us, c->err)) ||
-        (rc = cdl_pbrt_get_float(ps, "vscale", 1.0, &vs, c->err)) ||
-        (rc = cdl_pbrt_get_float(ps, "udelta", 0.0, &ud, c->err)) ||
-        (rc = cdl_pbrt_get_float(ps, "vdelta", 0.0, &vd, c->err)))
-        return rc;
-    if (!fn)
-        return cdl_pbrt_error(c, c->line, "imagemap texture \"%s\" needs \"string filename\"", t->name);
-    cdl_pbrt_find(ps, "filter");
-    cdl_pbrt_find(ps, "maxanisotropy");
-    cdl_pbrt_find(ps, "trilinear");
-    if (inv || strcmp(mapping, "uv") || strcmp(wrap, "repeat") || us != 1.0 || vs != 1.0 || ud != 0.0 ||
-        vd != 0.0)
-        cdl_pbrt_warn(c, c->line, "imagemap \"%s\": invert, mapping, wrap and uv scale/offset are ignored "
-                                  "(plain repeating uv lookup)", t->name);
-    if (!gamma || strcmp(enc, "sRGB"))
-        cdl_pbrt_warn(c, c->line, "imagemap \"%s\": 8-bit images are always decoded as sRGB", t->name);
-    char path[1024];
-    cdl_pbrt_resolve(c, fn, path, sizeof path);
-    if ((rc = cdl_pbrt_check_file(c, "texture file", path)))
-        return rc;
-    t->kind = CDL_PBRT_TEX_IMAGE;
-    t->value = cdl_v3((float)sc, (float)sc, (float)sc);
-    if (!(t->path = strdup(path)))
-        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
-    if (is_float)
-        return 0; /* float images are not looked up (constants only) */
-    for (int i = 0; i < c->ntexs; i++) /* one decoded copy per file */
-        if (c->texs[i].tex_id >= 0 && c->texs[i].path && !strcmp(c->texs[i].path, path)) {
-            t->tex_id = c->texs[i].tex_id;
+    /* a shape pbrt gives no vertex normals: the same material displacing
+     * the surface partials, made once */
+    for (int i = 0; i < c->nvariants; i++)
+        if (c->variants[2 * i] == (int32_t)mat) {
+            *out = (uint32_t)c->variants[2 * i + 1];
             return 0;
         }
-    if ((rc = cdl_scene_add_texture(c->s, path, &t->tex_id, c->err))) {
-        /* name the Texture directive; the image's own message follows */
-        cdl_error sub = *c->err;
-        return cdl_error_set(c->err, sub.code, c->file, c->line, "texture \"%s\": %s", path, sub.msg);
-    }
-    return 0;
-}
-
-int cdl_pbrt_texture(cdl_pbrt_ctx *c, const char *name, const char *type, const char *cls)
-{
-    cdl_pbrt_tex t;
-    memset(&t, 0, sizeof t);
-    t.tex_id = -1;
-    int rc = 0;
-    if (!strcmp(type, "float"))
-        t.is_float = 1;
-    else if (strcmp(type, "spectrum") && strcmp(type, "color") && strcmp(type, "rgb"))
-        return cdl_pbrt_error(c, c->line, "Texture \"%s\": type \"%s\" must be \"float\" or \"spectrum\"", name,
-                              type);
-    if (!(t.name = strdup(name)))
-        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
-    if (!strcmp(cls, "imagemap")) {
-        rc = image_texture(c, t.is_float, &t);
-    } else if (!strcmp(cls, "constant")) {
-        double f;
-        t.kind = CDL_PBRT_TEX_CONST;
-        if (t.is_float) {
-            rc = cdl_pbrt_get_float(&c->ps, "value", 1.0, &f, c->err);
-            t.value = cdl_v3((float)f, (float)f, (float)f);
-        } else {
-            rc = cdl_pbrt_get_spectrum(&c->ps, "value", cdl_v3(1, 1, 1), &t.value, NULL, c->err);
-        }
-    } else if (!strcmp(cls, "scale")) {
-        /* v3: tex1 * tex2; v4: tex * scale */
-        cdl_pbrt_tex a, b;
-        int v4 = cdl_pbrt_find(&c->ps, "tex") != NULL;
-        if (!(rc = tex_operand(c, v4 ? "tex" : "tex1", &a)) && !(rc = tex_operand(c, v4 ? "scale" : "tex2", &b))) {
-            if (a.kind == CDL_PBRT_TEX_IMAGE && b.kind == CDL_PBRT_TEX_CONST)
-                t = (cdl_pbrt_tex){t.name, t.is_float, a.kind, cdl_mul(a.value, b.value), a.tex_id, NULL};
-            else if (b.kind == CDL_PBRT_TEX_IMAGE && a.kind == CDL_PBRT_TEX_CONST)
-                t = (cdl_pbrt_tex){t.name, t.is_float, b.kind, cdl_mul(a.value, b.value), b.tex_id, NULL};
-            else if (a.kind == CDL_PBRT_TEX_CONST && b.kind == CDL_PBRT_TEX_CONST)
-                t = (cdl_pbrt_tex){t.name, t.is_float, a.kind, cdl_mul(a.value, b.value), -1, NULL};
-            else {
-                cdl_pbrt_warn(c, c->line, "scale texture \"%s\" of two non-constant textures: grey 0.5", name);
-                t.kind = CDL_PBRT_TEX_OTHER;
-                t.value = cdl_v3(0.5f, 0.5f, 0.5f);
-            }
-        }
-    } else {
-        cdl_pbrt_warn(c, c->line, "texture class \"%s\" is not supported: \"%s\" is grey 0.5", cls, name);
-        t.kind = CDL_PBRT_TEX_OTHER;
-        t.value = cdl_v3(0.5f, 0.5f, 0.5f);
-        for (size_t i = 0; i < c->ps.n; i++)
-            c->ps.p[i].used = 1;
-    }
-    if (!rc && c->ntexs == c->captexs) {
-        int cap = c->captexs ? 2 * c->captexs : 16;
-        cdl_pbrt_tex *p = realloc(c->texs, sizeof *p * (size_t)cap);
-        if (!p)
-            rc = cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
-        else {
-            c->texs = p;
-            c->captexs = cap;
-        }
-    }
-    if (rc) {
-        free(t.name);
-        free(t.path);
+    cdl_material v = *m;
+    v.maps.bump_frame = CDL_BUMP_PARTIALS;
+    uint32_t id;
+    int rc = cdl_pbrt_scene_rc(c, cdl_scene_add_material(c->s, &v, &id, c->err));
+    if (rc)
         return rc;
+    if (c->nvariants == c->capvariants) {
+        int cap = c->capvariants ? 2 * c->capvariants : 8;
+        int32_t *p = realloc(c->variants, sizeof *p * 2 * (size_t)cap);
+        if (!p)
+            return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, c->line, "out of memory");
+        c->variants = p;
+        c->capvariants = cap;
     }
-    c->texs[c->ntexs++] = t;
+    c->variants[2 * c->nvariants] = (int32_t)mat;
+    c->variants[2 * c->nvariants++ + 1] = (int32_t)id;
+    *out = id;
     return 0;
 }

@@ -1,6 +1,6 @@
 /* pbrt shapes: triangle, bilinear-patch and PLY meshes, spheres (analytic
- * under similarity transforms, tessellated otherwise), disks and cylinders
- * (tessellated), and flattened object
+ * under similarity transforms and untextured materials, tessellated
+ * otherwise), disks and cylinders (tessellated), and flattened object
  * instances. Orientation follows pbrt-v3 exactly, since area lights emit
  * from the front face only: a triangle's normal is cross(p0 - p2, p1 - p2)
  * (= the CCW normal), turned towards the shading normals when the mesh has
@@ -130,21 +130,66 @@ static int read_ply(cdl_pbrt_ctx *c, cdl_mesh *m)
 /* swap_def: the handedness of the transform the sphere was defined
  * under. pbrt flips a sphere's normal by ReverseOrientation XOR it in
  * object space; an instance transform only carries that normal along. */
+/* Whether a material looks anything up by (u, v). */
+static int uv_textured(const cdl_material *m)
+{
+    const cdl_mat_maps *mm = &m->maps;
+    return m->kd_tex >= 0 || (m->masked && m->opacity_tex >= 0) ||
+           (mm->on && (mm->alpha_tex[0] >= 0 || mm->alpha_tex[1] >= 0 || mm->bump_tex >= 0 || mm->normal_tex >= 0));
+}
+
+/* pbrt's (u, v) of a mesh without them: (0,0), (1,0), (1,1) at a
+ * triangle's corners; a bilinear patch's are its own (u, v), on its two
+ * triangles (p00 p10 p11) and (p00 p11 p01). Corners are unshared. */
+static int default_uv(cdl_pbrt_ctx *c, const cdl_mesh *in, int quads, cdl_mesh *out)
+{
+    static const float tri[2][6] = {{0, 0, 1, 0, 1, 1}, {0, 0, 1, 1, 0, 1}};
+    int rc = cdl_mesh_alloc(out, 3 * in->ntris, in->ntris, in->nrm != NULL, 1, c->file, c->line, c->err);
+    if (rc)
+        return rc;
+    for (uint32_t t = 0; t < in->ntris; t++)
+        for (uint32_t k = 0; k < 3; k++) {
+            uint32_t v = in->idx[3 * t + k], o = 3 * t + k;
+            memcpy(out->pos + 3 * (size_t)o, in->pos + 3 * (size_t)v, 3 * sizeof(float));
+            if (in->nrm)
+                memcpy(out->nrm + 3 * (size_t)o, in->nrm + 3 * (size_t)v, 3 * sizeof(float));
+            out->uv[2 * (size_t)o] = tri[quads && (t & 1)][2 * k];
+            out->uv[2 * (size_t)o + 1] = tri[quads && (t & 1)][2 * k + 1];
+            out->idx[o] = o;
+        }
+    return 0;
+}
+
 static int emit_shape(cdl_pbrt_ctx *c, const cdl_pbrt_shape *sh, const cdl_mat4 *ctm, int reverse,
                       int swap_def, uint32_t mat, int32_t emit)
 {
+    /* pbrt's vertex normals: a user's mesh with "N" (the sphere's
+     * tessellation stands for pbrt's analytic sphere) */
+    int rc = cdl_pbrt_shape_material(c, mat, !sh->sphere && sh->mesh.nrm != NULL, &mat);
+    if (rc)
+        return rc;
+    if (!sh->sphere && !sh->mesh.uv && uv_textured(&c->s->mats[mat])) {
+        cdl_mesh m;
+        if ((rc = default_uv(c, &sh->mesh, sh->quads, &m)))
+            return rc;
+        rc = cdl_scene_add_mesh(c->s, &m, ctm, reverse, mat, emit, c->file, c->line, c->err);
+        cdl_mesh_free(&m);
+        return rc;
+    }
     if (!sh->sphere)
         return cdl_scene_add_mesh(c->s, &sh->mesh, ctm, reverse, mat, emit, c->file, c->line, c->err);
     double scale;
     int inward = reverse ^ swap_def;
-    if (cdl_mat4_is_similarity(ctm, 1e-4, &scale)) {
+    /* the analytic sphere's (u, v) are Mitsuba's: a textured sphere is
+     * tessellated, with pbrt's (u, v) */
+    if (cdl_mat4_is_similarity(ctm, 1e-4, &scale) && !uv_textured(&c->s->mats[mat])) {
         cdl_vec3 ctr = cdl_mat4_point3(ctm, cdl_v3(0, 0, 0));
         return cdl_pbrt_scene_rc(c, cdl_scene_add_sphere(c->s, ctr, (float)(sh->radius * scale), mat, emit,
                                                          inward, c->err));
     }
     cdl_mesh m;
     memset(&m, 0, sizeof m);
-    int rc = cdl_mesh_sphere(&m, sh->radius, inward, c->file, c->line, c->err);
+    rc = cdl_mesh_sphere(&m, sh->radius, inward, c->file, c->line, c->err);
     if (!rc)
         rc = cdl_scene_add_mesh(c->s, &m, ctm, reverse, mat, emit, c->file, c->line, c->err);
     cdl_mesh_free(&m);
@@ -248,7 +293,7 @@ int cdl_pbrt_shape_directive(cdl_pbrt_ctx *c, const char *type)
     if (!strcmp(type, "trianglemesh"))
         rc = read_mesh(c, 0, type, &sh.mesh);
     else if (!strcmp(type, "bilinearmesh"))
-        rc = read_mesh(c, 1, type, &sh.mesh);
+        rc = read_mesh(c, sh.quads = 1, type, &sh.mesh);
     else if (!strcmp(type, "loopsubdiv"))
         rc = read_loopsubdiv(c, &sh.mesh);
     else if (!strcmp(type, "plymesh"))

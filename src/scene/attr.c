@@ -177,8 +177,10 @@ typedef struct hit_at {
 static cdl_vec3 tex_at(const cdl_scene *s, int tex, const cdl_surface *sf, const hit_at *h)
 {
     const cdl_texture *t = &s->texs[tex];
-    if (t->type == CDL_TEX_SCALE && t->sub[0] >= 0 && s->texs[t->sub[0]].type == CDL_TEX_ATTRIBUTE)
-        return cdl_scale(tex_at(s, t->sub[0], sf, h), t->scale);
+    if (t->type == CDL_TEX_SCALE && t->sub[0] >= 0 && s->texs[t->sub[0]].type == CDL_TEX_ATTRIBUTE) {
+        cdl_vec3 b = t->sub[1] >= 0 ? cdl_texture_eval(s->texs, t->sub[1], sf->u, sf->v) : t->b;
+        return cdl_scale(cdl_mul(tex_at(s, t->sub[0], sf, h), b), t->scale);
+    }
     if (t->type == CDL_TEX_ATTRIBUTE)
         return cdl_scale(attr_at(s, t->attr_key, h->t, h->prim, h->b1, h->b2), t->scale);
     return cdl_texture_eval(s->texs, tex, sf->u, sf->v);

@@ -4,6 +4,8 @@
 #ifndef CDL_MATERIAL_H
 #define CDL_MATERIAL_H
 
+#include <math.h>
+
 #include "core/vec.h"
 #include "scene/bsdf_principled.h"
 
@@ -33,18 +35,47 @@ typedef enum cdl_mat_type {
  * to, never stores photons. */
 static inline int cdl_mat_is_delta(cdl_mat_type t) { return t == CDL_MAT_MIRROR || t == CDL_MAT_DIELECTRIC; }
 
+/* How a textured roughness becomes GGX alpha at each lookup: as it is
+ * (Mitsuba's alpha), pbrt-v3's RoughnessToAlpha, pbrt-v4's sqrt. */
+typedef enum cdl_rough_remap { CDL_ROUGH_ALPHA, CDL_ROUGH_PBRT3, CDL_ROUGH_PBRT4 } cdl_rough_remap;
+
+/* The surface partials a bump map displaces (p' = p + h n, dp'/du =
+ * S + dh/du n, dp'/dv = T + dh/dv n). PARTIALS: S, T = dp/du, dp/dv made
+ * perpendicular to n (Mitsuba; pbrt on shapes without vertex normals).
+ * pbrt's meshes with vertex normals displace its shading frame instead,
+ * with s = dp/du made perpendicular and normalized, t = n x s: pbrt-v3
+ * S, T = -s, -t (its triangle's ts = ss x ns, reversed and unit length:
+ * its issues #188, #261), pbrt-v4 S, T = |dp/du| s, |dp/du| t. */
+typedef enum cdl_bump_frame { CDL_BUMP_PARTIALS, CDL_BUMP_PBRT3_VN, CDL_BUMP_PBRT4_VN } cdl_bump_frame;
+
 /* Textures that vary a material over its surface beyond kd (texture
  * indices, -1 = none). bump: Mitsuba's bumpmap (the height's uv gradient
- * times bump_scale tilts the shading frame); normal: Mitsuba's normalmap
- * (2 rgb - 1 is the normal in the unperturbed shading frame). Read only
- * when `on`, so that a zeroed material has none. */
+ * times bump_scale tilts the shading frame), pbrt's bumpmap/displacement
+ * (bump_scale 1); normal: Mitsuba's normalmap and pbrt-v4's (2 rgb - 1 is
+ * the normal in the unperturbed shading frame: s along dp/du, t = n x s).
+ * Read only when `on`, so that a zeroed material has none. */
 typedef struct cdl_mat_maps {
     int on;
     int alpha_tex[2]; /* alpha_x, alpha_y from the textures' scalar values */
+    int alpha_remap;  /* cdl_rough_remap of those values */
     int bump_tex;
     float bump_scale;
+    int bump_frame;   /* cdl_bump_frame */
     int normal_tex;
 } cdl_mat_maps;
+
+/* A roughness r as GGX alpha (cdl_rough_remap): pbrt-v3's
+ * TrowbridgeReitzDistribution::RoughnessToAlpha (log r, r clamped to
+ * 1e-3) or pbrt-v4's sqrt(r). */
+static inline float cdl_roughness_to_alpha(double r, int remap)
+{
+    if (remap == CDL_ROUGH_PBRT4)
+        return (float)sqrt(r > 0.0 ? r : 0.0);
+    if (remap != CDL_ROUGH_PBRT3)
+        return (float)r;
+    double x = log(r > 1e-3 ? r : 1e-3);
+    return (float)(1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x * x * x + 0.000640711 * x * x * x * x);
+}
 
 /* The shading frame of this material follows dp/du (Mitsuba's): its
  * roughness is anisotropic or a map perturbs the frame. */

@@ -172,10 +172,11 @@ int cdl_scene_add_texture(cdl_scene *s, const char *path, int *id, cdl_error *er
 
 int cdl_scene_add_texture_data(cdl_scene *s, cdl_texture *t, int *id, cdl_error *err)
 {
-    for (int k = 0; k < 2; k++)
-        if (t->sub[k] >= (int)s->ntexs || t->sub[k] < -1) {
+    int subs[3] = {t->sub[0], t->sub[1], t->type == CDL_TEX_MIX ? t->amount_tex : -1};
+    for (int k = 0; k < 3; k++)
+        if (subs[k] >= (int)s->ntexs || subs[k] < -1) {
             cdl_texture_free(t);
-            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sub-texture %d out of range", t->sub[k]);
+            return cdl_error_set(err, CDL_ERR_INPUT, s->path, 0, "sub-texture %d out of range", subs[k]);
         }
     if (cdl_grow((void **)&s->texs, &s->cap_texs, s->ntexs + 1, sizeof(cdl_texture))) {
         cdl_texture_free(t);

@@ -5,7 +5,9 @@
 cdl_vec3 cdl_bump_normal(cdl_vec3 dpdu, cdl_vec3 dpdv, const float grad[2], cdl_vec3 s, cdl_vec3 t, cdl_vec3 n,
                          cdl_vec3 ng)
 {
-    /* the displaced surface p + h n, ignoring dn/du (Mitsuba's bumpmap) */
+    /* the displaced surface p + h n, ignoring dn/du (Mitsuba's bumpmap;
+     * pbrt adds h dn/du, a relative change of h times the curvature that
+     * candela drops) */
     cdl_vec3 du = cdl_madd(dpdu, n, grad[0] - cdl_dot(n, dpdu));
     cdl_vec3 dv = cdl_madd(dpdv, n, grad[1] - cdl_dot(n, dpdv));
     cdl_vec3 c = cdl_cross(du, dv);
@@ -39,7 +41,14 @@ void cdl_surface_shade(const cdl_scene *s, cdl_surface *sf, cdl_vec3 wo)
         cdl_texture_grad1(s->texs, m->maps.bump_tex, sf->u, sf->v, g);
         g[0] *= m->maps.bump_scale;
         g[1] *= m->maps.bump_scale;
-        np = cdl_bump_normal(sf->dpdu, sf->dpdv, g, ts, tb, n, sf->ng);
+        /* the partials the height displaces (cdl_bump_frame) */
+        cdl_vec3 bu = sf->dpdu, bv = sf->dpdv;
+        if (m->maps.bump_frame == CDL_BUMP_PBRT3_VN || m->maps.bump_frame == CDL_BUMP_PBRT4_VN) {
+            float l = m->maps.bump_frame == CDL_BUMP_PBRT3_VN ? -1.0f : len > 0.0f && isfinite(len) ? len : 0.0f;
+            bu = cdl_scale(ts, l);
+            bv = cdl_scale(tb, l);
+        }
+        np = cdl_bump_normal(bu, bv, g, ts, tb, n, sf->ng);
     } else if (m->maps.normal_tex >= 0) {
         cdl_vec3 c = cdl_texture_eval(s->texs, m->maps.normal_tex, sf->u, sf->v);
         np = cdl_v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
@@ -69,6 +78,8 @@ void cdl_scene_bsdf_maps(const cdl_scene *s, const cdl_material *m, const cdl_su
     for (int k = 0; k < 2 && m->maps.on; k++)
         if (m->maps.alpha_tex[k] >= 0) {
             float a = cdl_texture_eval1(s->texs, m->maps.alpha_tex[k], sf->u, sf->v);
+            if (m->maps.alpha_remap != CDL_ROUGH_ALPHA && isfinite(a))
+                a = cdl_roughness_to_alpha(a, m->maps.alpha_remap);
             a = isfinite(a) ? cdl_maxf(a, 1e-4f) : 1e-4f;
             if (k == 0)
                 b->ax = a;

@@ -25,6 +25,8 @@ void cdl_texture_init(cdl_texture *t, cdl_tex_type type)
     t->sub[0] = t->sub[1] = -1;
     t->scale = 1.0f;
     t->attr_key = -1;
+    t->amount_tex = -1;
+    t->amount = 0.5f;
 }
 
 int cdl_texture_load_image(cdl_texture *t, const char *path, int raw, cdl_error *err)
@@ -108,10 +110,11 @@ cdl_vec3 cdl_texture_lookup(const cdl_texture *t, float u, float v)
 }
 
 /* An integer texel index brought into [0, n) as Dr.Jit's textures do:
- * repeat, mirror (0 1 .. n-1 n-1 .. 0 0 1 ..) or clamp. */
+ * repeat, mirror (0 1 .. n-1 n-1 .. 0 0 1 ..) or clamp (black: the
+ * caller has taken the texels outside). */
 static int wrap_index(int i, int n, int mode)
 {
-    if (mode == CDL_WRAP_CLAMP)
+    if (mode == CDL_WRAP_CLAMP || mode == CDL_WRAP_BLACK)
         return i < 0 ? 0 : (i >= n ? n - 1 : i);
     if (mode == CDL_WRAP_MIRROR) {
         int p = i % (2 * n);
@@ -125,6 +128,8 @@ static int wrap_index(int i, int n, int mode)
 
 static cdl_vec3 pixel(const cdl_texture *t, int x, int y)
 {
+    if (t->wrap == CDL_WRAP_BLACK && (x < 0 || x >= t->w || y < 0 || y >= t->h))
+        return cdl_v3(0.0f, 0.0f, 0.0f);
     x = wrap_index(x, t->w, t->wrap);
     y = wrap_index(y, t->h, t->wrap);
     const float *p = t->rgb + 3 * ((size_t)y * (size_t)t->w + (size_t)x);
@@ -174,18 +179,66 @@ static cdl_vec3 bitmap_eval(const cdl_texture *t, float u, float v)
     return cdl_add(cdl_scale(a, 1.0f - wy), cdl_scale(b, wy));
 }
 
-/* Mitsuba's checkerboard: the cell parity of to_uv(uv). Its color lookup
- * takes color0 where both halves agree, its scalar lookup (the legacy
- * convention Mitsuba keeps) where they differ. */
+/* Whether a checkerboard shows a (else b) at (u, v). Mitsuba's: the
+ * parity of the half cells of to_uv(uv), its color lookup taking color0
+ * where both halves agree, its scalar lookup (the legacy convention
+ * Mitsuba keeps) where they differ. pbrt's (unit_cells): tex1 where
+ * floor(s) + floor(t) is even, for both (its negative cells too: C++'s
+ * -1 % 2 is -1, not 0). */
 static int checker_first(const cdl_texture *t, float u, float v, int scalar)
 {
     float s = t->m[0] * u + t->m[1] * v + t->m[2];
     float tt = t->m[3] * u + t->m[4] * v + t->m[5];
+    if (t->unit_cells) {
+        if (!isfinite(s) || !isfinite(tt))
+            return 1;
+        /* the parity of the sum, exact while the cells are integers in float */
+        float h = 0.5f * (floorf(s) + floorf(tt));
+        return h == floorf(h);
+    }
     int mx = s - floorf(s) > 0.5f, my = tt - floorf(tt) > 0.5f;
     return scalar ? mx != my : mx == my;
 }
 
 #define MAX_TEX_DEPTH 8
+
+/* The scalar of a constant operand: exact for a grey (a pbrt float). */
+static float scalar_of(cdl_vec3 c)
+{
+    return c.x == c.y && c.y == c.z ? c.x : cdl_tex_luminance(c);
+}
+
+/* A checker's constant as a scalar: Mitsuba's luminance, pbrt's float. */
+static float checker_const1(const cdl_texture *t, int k)
+{
+    cdl_vec3 c = k == 0 ? t->a : t->b;
+    return t->unit_cells ? scalar_of(c) : cdl_tex_luminance(c);
+}
+
+static cdl_vec3 eval_depth(const cdl_texture *texs, int i, float u, float v, int depth);
+static float eval1_depth(const cdl_texture *texs, int i, float u, float v, int depth);
+
+/* Operand k of a checker, scale or mix: its texture or its constant. */
+static cdl_vec3 operand(const cdl_texture *texs, const cdl_texture *t, int k, float u, float v, int depth)
+{
+    if (t->sub[k] >= 0 && depth < MAX_TEX_DEPTH)
+        return eval_depth(texs, t->sub[k], u, v, depth + 1);
+    return k == 0 ? t->a : t->b;
+}
+
+static float operand1(const cdl_texture *texs, const cdl_texture *t, int k, float u, float v, int depth)
+{
+    if (t->sub[k] >= 0 && depth < MAX_TEX_DEPTH)
+        return eval1_depth(texs, t->sub[k], u, v, depth + 1);
+    return scalar_of(k == 0 ? t->a : t->b);
+}
+
+static float mix_amount(const cdl_texture *texs, const cdl_texture *t, float u, float v, int depth)
+{
+    if (t->amount_tex >= 0 && depth < MAX_TEX_DEPTH)
+        return eval1_depth(texs, t->amount_tex, u, v, depth + 1);
+    return t->amount;
+}
 
 static cdl_vec3 eval_depth(const cdl_texture *texs, int i, float u, float v, int depth)
 {
@@ -193,15 +246,18 @@ static cdl_vec3 eval_depth(const cdl_texture *texs, int i, float u, float v, int
     switch (t->type) {
     case CDL_TEX_BITMAP:
         return bitmap_eval(t, u, v);
-    case CDL_TEX_CHECKER: {
-        int k = checker_first(t, u, v, 0) ? 0 : 1;
-        if (t->sub[k] >= 0 && depth < MAX_TEX_DEPTH)
-            return eval_depth(texs, t->sub[k], u, v, depth + 1);
-        return k == 0 ? t->a : t->b;
-    }
+    case CDL_TEX_CHECKER:
+        return operand(texs, t, checker_first(t, u, v, 0) ? 0 : 1, u, v, depth);
     case CDL_TEX_SCALE: {
         cdl_vec3 c = t->sub[0] >= 0 && depth < MAX_TEX_DEPTH ? eval_depth(texs, t->sub[0], u, v, depth + 1) : t->a;
+        if (t->sub[1] >= 0 || t->b.x != 1.0f || t->b.y != 1.0f || t->b.z != 1.0f)
+            c = cdl_mul(c, operand(texs, t, 1, u, v, depth));
         return cdl_scale(c, t->scale);
+    }
+    case CDL_TEX_MIX: {
+        float w = mix_amount(texs, t, u, v, depth);
+        return cdl_add(cdl_scale(operand(texs, t, 0, u, v, depth), 1.0f - w),
+                       cdl_scale(operand(texs, t, 1, u, v, depth), w));
     }
     default:
         return t->a;
@@ -215,10 +271,16 @@ static float eval1_depth(const cdl_texture *texs, int i, float u, float v, int d
         int k = checker_first(t, u, v, 1) ? 0 : 1;
         if (t->sub[k] >= 0 && depth < MAX_TEX_DEPTH)
             return eval1_depth(texs, t->sub[k], u, v, depth + 1);
-        return cdl_tex_luminance(k == 0 ? t->a : t->b);
+        return checker_const1(t, k);
     }
+    if (t->type == CDL_TEX_SCALE && t->sub[1] >= 0)
+        return t->scale * operand1(texs, t, 0, u, v, depth) * operand1(texs, t, 1, u, v, depth);
     if (t->type == CDL_TEX_SCALE && t->sub[0] >= 0 && depth < MAX_TEX_DEPTH)
-        return t->scale * eval1_depth(texs, t->sub[0], u, v, depth + 1);
+        return t->scale * scalar_of(t->b) * eval1_depth(texs, t->sub[0], u, v, depth + 1);
+    if (t->type == CDL_TEX_MIX) {
+        float w = mix_amount(texs, t, u, v, depth);
+        return (1.0f - w) * operand1(texs, t, 0, u, v, depth) + w * operand1(texs, t, 1, u, v, depth);
+    }
     return cdl_tex_luminance(eval_depth(texs, i, u, v, depth));
 }
 
@@ -234,17 +296,11 @@ float cdl_texture_eval1(const cdl_texture *texs, int i, float u, float v)
 
 /* Mitsuba's eval_1_grad of a bilinear bitmap: the derivative of the
  * interpolant over the image coordinates, taken back to (u, v) through
- * the uv map (its transpose). Other textures are piecewise constant. */
-void cdl_texture_grad1(const cdl_texture *texs, int i, float u, float v, float grad[2])
+ * the uv map (its transpose). */
+static void bitmap_grad1(const cdl_texture *t, float u, float v, float grad[2])
 {
-    const cdl_texture *t = &texs[i];
-    float sc = 1.0f;
-    for (int d = 0; t->type == CDL_TEX_SCALE && t->sub[0] >= 0 && d < MAX_TEX_DEPTH; d++) {
-        sc *= t->scale;
-        t = &texs[t->sub[0]];
-    }
     grad[0] = grad[1] = 0.0f;
-    if (t->type != CDL_TEX_BITMAP || t->nearest)
+    if (t->nearest)
         return;
     const float *m = t->m;
     float s, tt;
@@ -257,6 +313,52 @@ void cdl_texture_grad1(const cdl_texture *texs, int i, float u, float v, float g
     /* per unit of s and t */
     float ds = (float)t->w * ((1.0f - wy) * (f10 - f00) + wy * (f11 - f01));
     float dt = (float)t->h * ((1.0f - wx) * (f01 - f00) + wx * (f11 - f10));
-    grad[0] = sc * (m[0] * ds + m[3] * dt);
-    grad[1] = sc * (m[1] * ds + m[4] * dt);
+    grad[0] = m[0] * ds + m[3] * dt;
+    grad[1] = m[1] * ds + m[4] * dt;
+}
+
+/* The scalar value of texture i and its gradient: bitmaps by their
+ * interpolant, products and mixes by the product rule, a checker by the
+ * operand it shows (its cell edges have no derivative); constants add 0. */
+static float grad1_depth(const cdl_texture *texs, int i, float u, float v, int depth, float g[2])
+{
+    const cdl_texture *t = &texs[i];
+    g[0] = g[1] = 0.0f;
+    if (depth >= MAX_TEX_DEPTH)
+        return eval1_depth(texs, i, u, v, depth);
+    switch (t->type) {
+    case CDL_TEX_BITMAP:
+        bitmap_grad1(t, u, v, g);
+        return eval1_depth(texs, i, u, v, depth);
+    case CDL_TEX_CHECKER: {
+        int k = checker_first(t, u, v, 1) ? 0 : 1;
+        if (t->sub[k] >= 0)
+            return grad1_depth(texs, t->sub[k], u, v, depth + 1, g);
+        return checker_const1(t, k);
+    }
+    case CDL_TEX_SCALE:
+    case CDL_TEX_MIX: {
+        float f[2], gk[2][2] = {{0.0f, 0.0f}, {0.0f, 0.0f}};
+        for (int k = 0; k < 2; k++)
+            f[k] = t->sub[k] >= 0 ? grad1_depth(texs, t->sub[k], u, v, depth + 1, gk[k]) : scalar_of(k ? t->b : t->a);
+        if (t->type == CDL_TEX_SCALE) {
+            for (int d = 0; d < 2; d++)
+                g[d] = t->scale * (gk[0][d] * f[1] + f[0] * gk[1][d]);
+            return t->scale * f[0] * f[1];
+        }
+        float gw[2] = {0.0f, 0.0f}, w = t->amount;
+        if (t->amount_tex >= 0)
+            w = grad1_depth(texs, t->amount_tex, u, v, depth + 1, gw);
+        for (int d = 0; d < 2; d++)
+            g[d] = (1.0f - w) * gk[0][d] + w * gk[1][d] + (f[1] - f[0]) * gw[d];
+        return (1.0f - w) * f[0] + w * f[1];
+    }
+    default:
+        return eval1_depth(texs, i, u, v, depth);
+    }
+}
+
+void cdl_texture_grad1(const cdl_texture *texs, int i, float u, float v, float grad[2])
+{
+    grad1_depth(texs, i, u, v, 0, grad);
 }
