@@ -119,6 +119,10 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat);
  * 0 when none); strict: a <ref> to anything else is an error (shapes),
  * else skipped (a wrapper's texture). */
 int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat, int *found);
+/* Colour property `name` of n (def when absent): a value, a nested
+ * <texture> or a <ref> to one; tex (NULL: values only, a texture warns and
+ * gives its scale) receives the texture or -1. Negative values fail. */
+int cdl_mts_color_prop(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex);
 /* A top-level or nested <texture>: scene texture (or -1) and value. */
 int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value);
 /* An <emitter type="area"> inside a shape: the scene emitter. */

@@ -1,4 +1,5 @@
-/* Mitsuba bsdfs, textures and emitters as candela's materials and lights.
+/* Mitsuba bsdfs and textures as candela's materials (emitters:
+ * mitsuba_emitters.c).
  * Defaults are Mitsuba 3's; what candela has no model for is approximated
  * with a warning. Plastic and roughplastic are Mitsuba's own coated model
  * (scene/plastic.h); they and the rough conductors and dielectrics use
@@ -66,7 +67,7 @@ static int nested_id(cdl_mts_ctx *c, const cdl_xml_node *n, cdl_mts_kind kind, i
     return cdl_mts_add_id(c, n, &v);
 }
 
-static int color(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex)
+int cdl_mts_color_prop(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex)
 {
     cdl_xml_node *p = cdl_mts_prop(c, n, name);
     *out = def;
@@ -116,7 +117,7 @@ static int conductor_eta(cdl_mts_ctx *c, cdl_xml_node *n, cdl_vec3 def, cdl_vec3
 {
     cdl_xml_node *p = cdl_mts_prop(c, n, "eta");
     if (!p || !strcmp(p->name, "ref") || !strcmp(p->name, "texture"))
-        return color(c, n, "eta", def, out, NULL);
+        return cdl_mts_color_prop(c, n, "eta", def, out, NULL);
     cdl_vec3 v;
     int rc = cdl_mts_color_node(c, p, &v);
     if (rc)
@@ -248,8 +249,8 @@ static int conductor(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m
             cdl_pbrt_named_spectrum("metal-Cu-k", &m->k3);
         }
     }
-    if ((rc = conductor_eta(c, n, m->eta3, &m->eta3)) || (rc = color(c, n, "k", m->k3, &m->k3, NULL)) ||
-        (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
+    if ((rc = conductor_eta(c, n, m->eta3, &m->eta3)) || (rc = cdl_mts_color_prop(c, n, "k", m->k3, &m->k3, NULL)) ||
+        (rc = cdl_mts_color_prop(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
         (rc = roughness(c, n, rough, m)))
         return rc;
     m->ks = at_most_one(c, n->line, "specular_reflectance", m->ks);
@@ -280,8 +281,8 @@ static int plastic(cdl_mts_ctx *c, cdl_xml_node *n, int rough, cdl_material *m)
     int rc, ks_given = ksn != NULL;
     if (ksn)
         ksn->used = 0; /* read below */
-    if ((rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)) ||
-        (rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
+    if ((rc = cdl_mts_color_prop(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)) ||
+        (rc = cdl_mts_color_prop(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m->ks, NULL)) ||
         (rc = rel_ior(c, n, 1.49, &m->eta)) || (rc = roughness(c, n, rough, m)) ||
         (rc = cdl_mts_bool(c, n, "nonlinear", 0, &m->nonlinear)))
         return rc;
@@ -304,7 +305,7 @@ static int mask(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     cdl_vec3 v;
     int tex, rc, found;
     int32_t inner;
-    if ((rc = color(c, n, "opacity", cdl_v3(0.5f, 0.5f, 0.5f), &v, &tex)) ||
+    if ((rc = cdl_mts_color_prop(c, n, "opacity", cdl_v3(0.5f, 0.5f, 0.5f), &v, &tex)) ||
         (rc = cdl_mts_child_bsdf(c, n, 0, &inner, &found)))
         return rc;
     if (!found)
@@ -360,7 +361,7 @@ static int principled(cdl_mts_ctx *c, cdl_xml_node *n, int thin, cdl_material *m
     int rc;
     *m = cdl_material_default(CDL_MAT_PRINCIPLED);
     m->pr = cdl_principled_default(thin);
-    if ((rc = color(c, n, "base_color", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)))
+    if ((rc = cdl_mts_color_prop(c, n, "base_color", cdl_v3(0.5f, 0.5f, 0.5f), &m->kd, &m->kd_tex)))
         return rc;
     m->kd = at_most_one(c, n->line, "base_color", m->kd);
     for (size_t i = 0; i < sizeof P / sizeof P[0]; i++) {
@@ -368,7 +369,7 @@ static int principled(cdl_mts_ctx *c, cdl_xml_node *n, int thin, cdl_material *m
             continue;
         float def = m->pr.value[P[i].slot];
         cdl_vec3 v;
-        if ((rc = color(c, n, P[i].name, cdl_v3(def, def, def), &v, &m->pr.tex[P[i].slot])))
+        if ((rc = cdl_mts_color_prop(c, n, P[i].name, cdl_v3(def, def, def), &v, &m->pr.tex[P[i].slot])))
             return rc;
         /* a colour where a float belongs: its luminance (Mitsuba's eval_1) */
         float x = 0.212671f * v.x + 0.715160f * v.y + 0.072169f * v.z;
@@ -519,14 +520,14 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     int rough = !strncmp(type, "rough", 5);
     if (!strcmp(type, "diffuse") || !strcmp(type, "roughdiffuse")) {
         m = cdl_material_default(CDL_MAT_DIFFUSE);
-        rc = color(c, n, "reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
+        rc = cdl_mts_color_prop(c, n, "reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
         if (!rc && type[0] == 'r') {
             /* Mitsuba 0.6: sigma = alpha / sqrt(2), the full model unless
              * use_fast_approx */
             double alpha;
             int fast;
             if (!cdl_mts_prop(c, n, "reflectance") && cdl_mts_prop(c, n, "diffuse_reflectance"))
-                rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
+                rc = cdl_mts_color_prop(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex);
             if (!rc && !(rc = cdl_mts_float(c, n, "alpha", 0.2, &alpha)) &&
                 !(rc = cdl_mts_bool(c, n, "use_fast_approx", 0, &fast))) {
                 if (!(alpha >= 0.0 && alpha <= 10.0))
@@ -545,8 +546,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         if (type[0] == 't')
             cdl_mts_warn(c, n->line, "bsdf \"thindielectric\": rendered as a dielectric interface");
         if (!(rc = rel_ior(c, n, 1.5046, &m.eta)) &&
-            !(rc = color(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
-            !(rc = color(c, n, "specular_transmittance", cdl_v3(1, 1, 1), &m.kt, NULL)))
+            !(rc = cdl_mts_color_prop(c, n, "specular_reflectance", cdl_v3(1, 1, 1), &m.ks, NULL)) &&
+            !(rc = cdl_mts_color_prop(c, n, "specular_transmittance", cdl_v3(1, 1, 1), &m.kt, NULL)))
             rc = roughness(c, n, rough, &m);
         m.ks = at_most_one(c, n->line, "specular_reflectance", m.ks);
         m.kt = at_most_one(c, n->line, "specular_transmittance", m.kt);
@@ -555,8 +556,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     } else if (!strcmp(type, "phong")) {
         double e = 30.0;
         m = cdl_material_default(CDL_MAT_PHONG);
-        if (!(rc = color(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
-            !(rc = color(c, n, "specular_reflectance", cdl_v3(0.2f, 0.2f, 0.2f), &m.ks, NULL)) &&
+        if (!(rc = cdl_mts_color_prop(c, n, "diffuse_reflectance", cdl_v3(0.5f, 0.5f, 0.5f), &m.kd, &m.kd_tex)) &&
+            !(rc = cdl_mts_color_prop(c, n, "specular_reflectance", cdl_v3(0.2f, 0.2f, 0.2f), &m.ks, NULL)) &&
             !(rc = cdl_mts_float(c, n, "exponent", 30.0, &e)) && !(e >= 0.0 && e <= 1e6))
             rc = cdl_mts_error(c, n->line, "phong exponent %g must be in [0, 1e6]", e);
         m.ns = (float)e;
@@ -584,7 +585,7 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
             p = cdl_mts_prop(c, n, "base_color");
         if (p)
             p->used = 0;
-        if (p && color(c, n, cdl_xml_attr_get(p, "name"), m.kd, &m.kd, &m.kd_tex))
+        if (p && cdl_mts_color_prop(c, n, cdl_xml_attr_get(p, "name"), m.kd, &m.kd, &m.kd_tex))
             return CDL_ERR_INPUT;
         for (int k = 0; k < n->nkids; k++)
             n->kids[k].used = 1;
@@ -624,261 +625,5 @@ int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value)
             n->kids[k].used = 1;
     }
     cdl_mts_warn_unused(c, n, type);
-    return 0;
-}
-
-static int check_emission(cdl_mts_ctx *c, int line, const char *what, cdl_vec3 v)
-{
-    if (!cdl_is_finite3(v) || v.x < 0.0f || v.y < 0.0f || v.z < 0.0f || cdl_max3(v) > 1e12f)
-        return cdl_mts_error(c, line, "%s (%g, %g, %g) must be finite, >= 0 and <= 1e12", what, (double)v.x,
-                             (double)v.y, (double)v.z);
-    return 0;
-}
-
-int cdl_mts_area(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *emit)
-{
-    char type[64];
-    cdl_vec3 L;
-    int rc = cdl_mts_type(c, n, type, sizeof type);
-    if (rc)
-        return rc;
-    n->used = 1;
-    if (strcmp(type, "area"))
-        return cdl_mts_error(c, n->line, "emitter \"%s\" inside a <shape>: only \"area\" belongs there", type);
-    int tex;
-    if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &L, &tex)) ||
-        (rc = check_emission(c, n->line, "area radiance", L)))
-        return rc;
-    cdl_mts_prop(c, n, "sampling_weight");
-    cdl_mts_warn_unused(c, n, "emitter \"area\"");
-    /* Mitsuba's area emitters shine from the front face only; a bitmap
-     * radiance is looked up at the surface's uv as a reflectance is */
-    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_emitter(c->s, L, 0, emit, c->err))))
-        return rc;
-    c->s->emitters[*emit].tex = tex;
-    return 0;
-}
-
-int cdl_mts_latlong_light(cdl_mts_ctx *c, int line, const cdl_vec3 axes[3], const char *path, float scale, int w,
-                          int h, float *rgb)
-{
-    /* Mitsuba's map is y-up with u = atan2(x, -z) / 2 pi: pbrt-v3's z-up
-     * frame with x' = -z, y' = x, z' = y */
-    cdl_vec3 frame[3] = {cdl_scale(axes[2], -1.0f), axes[0], axes[1]};
-    /* the texel layout of Mitsuba's lat-long maps, one place for envmap and sunsky */
-    const int layout = CDL_ENVMAP_MITSUBA;
-    cdl_envmap *em = malloc(sizeof *em);
-    if (!em) {
-        free(rgb);
-        return cdl_error_set(c->err, CDL_ERR_SYSTEM, c->file, line, "out of memory");
-    }
-    int rc;
-    if (path) {
-        rc = cdl_envmap_load(em, path, cdl_v3(scale, scale, scale), frame, layout, c->err);
-    } else {
-        rc = cdl_envmap_init(em, w, h, rgb, frame, layout, c->err);
-        if (rc == CDL_ERR_INPUT) /* refused before it took the texels over */
-            free(rgb);
-        rc = cdl_mts_scene_rc(c, line, rc);
-    }
-    if (rc) {
-        free(em);
-        return rc;
-    }
-    return cdl_mts_scene_rc(c, line, cdl_scene_add_env_light(c->s, cdl_v3(1, 1, 1), em, c->err));
-}
-
-static int envmap(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
-{
-    char fn[1024], path[1024];
-    double scale;
-    int rc;
-    if ((rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn)) ||
-        (rc = cdl_mts_float(c, n, "scale", 1.0, &scale)))
-        return rc;
-    if (!fn[0])
-        return cdl_mts_error(c, n->line, "emitter \"envmap\" needs a \"filename\"");
-    if (!(scale >= 0.0 && scale <= 1e12))
-        return cdl_mts_error(c, n->line, "envmap scale %g must be in [0, 1e12]", scale);
-    if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
-        return rc;
-    cdl_mts_prop(c, n, "gamma");
-    cdl_mts_prop(c, n, "cache");
-    cdl_mts_prop(c, n, "filter_type");
-    cdl_vec3 axes[3] = {cdl_mat4_vector3(m, cdl_v3(1, 0, 0)), cdl_mat4_vector3(m, cdl_v3(0, 1, 0)),
-                        cdl_mat4_vector3(m, cdl_v3(0, 0, 1))};
-    return cdl_mts_latlong_light(c, n->line, axes, path, (float)scale, 0, 0, NULL);
-}
-
-/* The unit frame of a spot or projector: to_world's x, y and z axes. */
-static int light_frame(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m, cdl_light *l)
-{
-    l->p = cdl_mat4_point3(m, cdl_v3(0, 0, 0));
-    cdl_vec3 x = cdl_mat4_vector3(m, cdl_v3(1, 0, 0)), y = cdl_mat4_vector3(m, cdl_v3(0, 1, 0)),
-             z = cdl_mat4_vector3(m, cdl_v3(0, 0, 1));
-    float lx = cdl_length(x), ly = cdl_length(y), lz = cdl_length(z);
-    if (!(lx > 0.0f && ly > 0.0f && lz > 0.0f) || !isfinite(lx + ly + lz))
-        return cdl_mts_error(c, n->line, "emitter to_world is singular");
-    l->ax = cdl_scale(x, 1.0f / lx);
-    l->ay = cdl_scale(y, 1.0f / ly);
-    l->n = cdl_scale(z, 1.0f / lz);
-    if (fabsf(cdl_dot(l->ax, l->ay)) > 1e-3f || fabsf(cdl_dot(l->ax, l->n)) > 1e-3f ||
-        fabsf(cdl_dot(l->ay, l->n)) > 1e-3f)
-        return cdl_mts_error(c, n->line, "emitter to_world must keep right angles (rotations, translations, scales)");
-    return 0;
-}
-
-/* Mitsuba 3's spot: intensity linear in the angle between beam_width and
- * cutoff_angle, times an optional texture projected over the cutoff cone. */
-static int spot(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
-{
-    double cut, beam;
-    cdl_light l;
-    cdl_vec3 k;
-    int rc;
-    memset(&l, 0, sizeof l);
-    l.type = CDL_LIGHT_SPOT;
-    l.spot_linear = 1;
-    if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &l.L, NULL)) ||
-        (rc = check_emission(c, n->line, "spot intensity", l.L)) ||
-        (rc = cdl_mts_float(c, n, "cutoff_angle", 20.0, &cut)) ||
-        (rc = cdl_mts_float(c, n, "beam_width", cut * 0.75, &beam)) ||
-        (rc = color(c, n, "texture", cdl_v3(1, 1, 1), &k, &l.tex_id)))
-        return rc;
-    if (!(cut > 0.0 && cut < 90.0))
-        return cdl_mts_error(c, n->line, "spot cutoff_angle %g must be in (0, 90) degrees", cut);
-    if (!(beam >= 0.0 && beam <= cut))
-        return cdl_mts_error(c, n->line, "spot beam_width %g must be in [0, cutoff_angle = %g]", beam, cut);
-    l.L = cdl_mul(l.L, k); /* a constant texture scales the intensity */
-    if ((rc = light_frame(c, n, m, &l)))
-        return rc;
-    l.cutoff = (float)(cut * CDL_PI / 180.0);
-    l.beam = (float)(beam * CDL_PI / 180.0);
-    l.cos_total = cosf(l.cutoff);
-    l.cos_falloff = cosf(l.beam);
-    l.tan_x = l.tan_y = tanf(l.cutoff);
-    cdl_mts_warn_unused(c, n, "emitter \"spot\"");
-    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_light(c->s, &l, c->err));
-}
-
-/* Mitsuba 3's projector: a perspective camera run backwards; the
- * irradiance (an image or a constant) at distance 1 along its axis, times
- * pi scale (Mitsuba's normalization: a white diffuse plane at distance 1
- * then has radiance irradiance * scale). */
-static int projector(cdl_mts_ctx *c, cdl_xml_node *n, const cdl_mat4 *m)
-{
-    double scale, fov;
-    char axis[32], fl[32];
-    cdl_light l;
-    cdl_vec3 E;
-    int rc;
-    memset(&l, 0, sizeof l);
-    l.type = CDL_LIGHT_PROJECTOR;
-    if ((rc = color(c, n, "irradiance", cdl_v3(1, 1, 1), &E, &l.tex_id)) ||
-        (rc = check_emission(c, n->line, "projector irradiance", E)) ||
-        (rc = cdl_mts_float(c, n, "scale", 1.0, &scale)) || (rc = cdl_mts_float(c, n, "fov", 0.0, &fov)) ||
-        (rc = cdl_mts_string(c, n, "fov_axis", "x", axis, sizeof axis)) ||
-        (rc = cdl_mts_string(c, n, "focal_length", "50mm", fl, sizeof fl)))
-        return rc;
-    if (!cdl_mts_prop(c, n, "irradiance"))
-        return cdl_mts_error(c, n->line, "emitter \"projector\" needs an \"irradiance\"");
-    if (!(scale >= 0.0 && scale <= 1e12))
-        return cdl_mts_error(c, n->line, "projector scale %g must be in [0, 1e12]", scale);
-    /* the image's aspect is the texture's (a constant: square) */
-    double aspect = 1.0;
-    if (l.tex_id >= 0)
-        aspect = (double)c->s->texs[l.tex_id].w / (double)c->s->texs[l.tex_id].h;
-    if (!cdl_mts_prop(c, n, "fov")) {
-        double f = strtod(fl, NULL);
-        if (!(f > 0.0 && f < 1e6))
-            return cdl_mts_error(c, n->line, "focal_length \"%s\" must be a positive length in mm", fl);
-        fov = 2.0 * atan(sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * f)) * 180.0 / CDL_PI;
-        snprintf(axis, sizeof axis, "diagonal");
-    }
-    if (!(fov > 0.0 && fov < 180.0))
-        return cdl_mts_error(c, n->line, "projector fov %g must be in (0, 180) degrees", fov);
-    double along;
-    if (!strcmp(axis, "x"))
-        along = aspect;
-    else if (!strcmp(axis, "y"))
-        along = 1.0;
-    else if (!strcmp(axis, "diagonal"))
-        along = sqrt(1.0 + aspect * aspect);
-    else if (!strcmp(axis, "smaller"))
-        along = aspect < 1.0 ? aspect : 1.0;
-    else if (!strcmp(axis, "larger"))
-        along = aspect > 1.0 ? aspect : 1.0;
-    else
-        return cdl_mts_error(c, n->line, "fov_axis \"%s\" must be x, y, diagonal, smaller or larger", axis);
-    if ((rc = light_frame(c, n, m, &l)))
-        return rc;
-    double tx = tan(fov * CDL_PI / 360.0) * aspect / along;
-    l.tan_x = (float)tx;
-    l.tan_y = (float)(tx / aspect);
-    l.L = cdl_scale(E, (float)(CDL_PI * scale));
-    cdl_mts_warn_unused(c, n, "emitter \"projector\"");
-    return cdl_mts_scene_rc(c, n->line, cdl_scene_add_light(c->s, &l, c->err));
-}
-
-int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
-{
-    char type[64];
-    int rc = cdl_mts_type(c, n, type, sizeof type), found;
-    if (rc)
-        return rc;
-    n->used = 1;
-    cdl_mat4 m;
-    cdl_vec3 v, p, d;
-    if ((rc = cdl_mts_transform(c, n, "to_world", &m)))
-        return rc;
-    cdl_mts_prop(c, n, "sampling_weight");
-    if (!strcmp(type, "area"))
-        return cdl_mts_error(c, n->line, "emitter \"area\" must be inside a <shape>");
-    if (!strcmp(type, "point")) {
-        if ((rc = color(c, n, "intensity", cdl_v3(1, 1, 1), &v, NULL)) ||
-            (rc = check_emission(c, n->line, "point intensity", v)) ||
-            (rc = cdl_mts_vec(c, n, "position", cdl_mat4_point3(&m, cdl_v3(0, 0, 0)), &p, NULL)))
-            return rc;
-        cdl_mts_warn_unused(c, n, "emitter \"point\"");
-        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_point_light(c->s, p, v, c->err));
-    }
-    if (!strcmp(type, "spot"))
-        return spot(c, n, &m);
-    if (!strcmp(type, "projector"))
-        return projector(c, n, &m);
-    if (!strcmp(type, "directional")) {
-        if ((rc = color(c, n, "irradiance", cdl_v3(1, 1, 1), &v, NULL)) ||
-            (rc = check_emission(c, n->line, "directional irradiance", v)) ||
-            (rc = cdl_mts_vec(c, n, "direction", cdl_mat4_vector3(&m, cdl_v3(0, 0, 1)), &d, &found)))
-            return rc;
-        if (!(cdl_length(d) > 0.0f))
-            return cdl_mts_error(c, n->line, "directional: the direction is zero");
-        cdl_mts_warn_unused(c, n, "emitter \"directional\"");
-        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_distant_light(c->s, d, v, c->err));
-    }
-    if (!strcmp(type, "constant")) {
-        if ((rc = color(c, n, "radiance", cdl_v3(1, 1, 1), &v, NULL)) ||
-            (rc = check_emission(c, n->line, "constant radiance", v)))
-            return rc;
-        cdl_mts_warn_unused(c, n, "emitter \"constant\"");
-        return cdl_mts_scene_rc(c, n->line, cdl_scene_add_infinite_light(c->s, v, c->err));
-    }
-    if (!strcmp(type, "envmap")) {
-        if ((rc = envmap(c, n, &m)))
-            return rc;
-        cdl_mts_warn_unused(c, n, "emitter \"envmap\"");
-        return 0;
-    }
-    if (!strcmp(type, "sunsky") || !strcmp(type, "sky") || !strcmp(type, "sun")) {
-        if ((rc = cdl_mts_sunsky(c, n, type, &m)))
-            return rc;
-        char what[80];
-        snprintf(what, sizeof what, "emitter \"%s\"", type);
-        cdl_mts_warn_unused(c, n, what);
-        return 0;
-    }
-    cdl_mts_warn(c, n->line, "emitter \"%s\" is not supported (ignored)", type);
-    for (int k = 0; k < n->nkids; k++)
-        n->kids[k].used = 1;
     return 0;
 }
