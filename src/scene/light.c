@@ -6,6 +6,13 @@
 #include "scene/envmap.h"
 #include "scene/texture.h"
 
+/* The light's texture at candela's (u, v), with the texture's own mapping,
+ * wrap and filter (tex points into the scene's array at tex_id). */
+static cdl_vec3 tex_eval(const cdl_light *l, float u, float v)
+{
+    return cdl_texture_eval(l->tex - l->tex_id, l->tex_id, u, v);
+}
+
 /* A uniform point on a triangle light, and its radiance there. */
 static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2, cdl_vec3 *L)
 {
@@ -15,16 +22,16 @@ static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2, cdl_vec3 
     if (l->tex) {
         float u = l->uv[0] + b1 * (l->uv[2] - l->uv[0]) + b2 * (l->uv[4] - l->uv[0]);
         float v = l->uv[1] + b1 * (l->uv[3] - l->uv[1]) + b2 * (l->uv[5] - l->uv[1]);
-        *L = cdl_mul(*L, cdl_texture_lookup(l->tex, u, v));
+        *L = cdl_mul(*L, tex_eval(l, u, v));
     }
     return cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
 }
 
 /* A texture projected by a spot or projector at Mitsuba's uv, whose v = 0
- * is the image's top row (candela's lookup has v = 0 at the bottom). */
+ * is the image's top row (candela's uv has v = 0 at the bottom). */
 static cdl_vec3 projected(const cdl_light *l, float u, float v)
 {
-    return cdl_texture_lookup(l->tex, u, 1.0f - v);
+    return tex_eval(l, u, 1.0f - v);
 }
 
 /* A cosine-distributed emission direction about e->n (area lights);
@@ -262,7 +269,7 @@ cdl_vec3 cdl_light_Le(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo)
 cdl_vec3 cdl_light_Le_uv(const cdl_light *l, cdl_vec3 ng, cdl_vec3 wo, float u, float v)
 {
     cdl_vec3 L = cdl_light_Le(l, ng, wo);
-    return l->tex && !cdl_is_black(L) ? cdl_mul(L, cdl_texture_lookup(l->tex, u, v)) : L;
+    return l->tex && !cdl_is_black(L) ? cdl_mul(L, tex_eval(l, u, v)) : L;
 }
 
 int cdl_light_sample_le(const cdl_light *l, float u1, float u2, float u3, float u4,

@@ -95,7 +95,9 @@ static cdl_vec3 texel(const cdl_texture *t, int x, int y)
     return cdl_v3(p[0], p[1], p[2]);
 }
 
-cdl_vec3 cdl_texture_lookup(const cdl_texture *t, float u, float v)
+/* The OBJ/pbrt readers' original lookup: bilinear, repeating; (u,v) as in
+ * OBJ: v = 0 is the bottom row. */
+static cdl_vec3 legacy_lookup(const cdl_texture *t, float u, float v)
 {
     if (!isfinite(u) || !isfinite(v))
         return texel(t, 0, 0);
@@ -166,7 +168,7 @@ static void bilinear_fetch(const cdl_texture *t, float s, float tt, cdl_vec3 f[4
 static cdl_vec3 bitmap_eval(const cdl_texture *t, float u, float v)
 {
     if (t->legacy)
-        return cdl_texture_lookup(t, u, v);
+        return legacy_lookup(t, u, v);
     float s, tt;
     image_st(t, u, v, &s, &tt);
     if (t->nearest)

@@ -56,9 +56,6 @@ int cdl_texture_load_image(cdl_texture *t, const char *path, int raw, cdl_error 
 /* A non-image texture at its defaults (uv (u, 1 - v), no sub-textures). */
 void cdl_texture_init(cdl_texture *t, cdl_tex_type type);
 void cdl_texture_free(cdl_texture *t);
-/* Bilinear, repeating; (u,v) as in OBJ: v = 0 is the bottom row. A bitmap
- * only (no sub-textures). */
-cdl_vec3 cdl_texture_lookup(const cdl_texture *t, float u, float v);
 
 /* Texture i of the array texs at surface (u, v): its color (Mitsuba's eval),
  * its scalar value (eval_1: the luminance of a color) and the gradient of
