@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "core/log.h"
 #include "io/loader.h"
 #include "io/ply.h"
 #include "scene/attr.h"
@@ -148,6 +149,34 @@ static void hits(void)
           "a bsdf reading an attribute the mesh lacks fails at the shape (line %d: %s)", err.line, err.msg);
 }
 
+static int attr_warnings;
+
+static void on_warning(void *user, const char *file, int line, const char *msg)
+{
+    (void)user;
+    (void)file;
+    attr_warnings += line == 3 && strstr(msg, "mesh_attribute") != NULL;
+}
+
+/* An attribute as a roughness is not read at the hit: a warning at the bsdf. */
+static void unread_slot(void)
+{
+    write_file("slot.xml", HEAD
+               "<texture type=\"mesh_attribute\" id=\"w\"><string name=\"name\" value=\"face_weight\"/></texture>\n"
+               "<bsdf type=\"roughconductor\" id=\"c\"><ref name=\"alpha\" id=\"w\"/></bsdf>\n"
+               "<shape type=\"ply\"><string name=\"filename\" value=\"q.ply\"/><ref id=\"c\"/></shape>\n</scene>\n");
+    cdl_scene s;
+    cdl_error err;
+    const cdl_log_sink sink = {on_warning, NULL, 0};
+    const cdl_log_sink *prev = cdl_log_push(&sink);
+    int rc = load("slot.xml", &s, &err);
+    cdl_log_pop(prev);
+    CHECK(rc == 0 && attr_warnings == 1, "an attribute as roughness loads with a warning at its bsdf (%d)",
+          attr_warnings);
+    if (!rc)
+        cdl_scene_free(&s);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/candela-attr.XXXXXX");
@@ -157,6 +186,7 @@ int main(void)
     }
     ply_attributes();
     hits();
+    unread_slot();
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd)) {

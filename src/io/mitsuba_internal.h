@@ -123,6 +123,9 @@ int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat
  * <texture> or a <ref> to one; tex (NULL: values only, a texture warns and
  * gives its scale) receives the texture or -1. Negative values fail. */
 int cdl_mts_color_prop(cdl_mts_ctx *c, cdl_xml_node *n, const char *name, cdl_vec3 def, cdl_vec3 *out, int *tex);
+/* Adds material m (warns where it reads a mesh attribute in a slot that
+ * cannot: only reflectances and blend weights are read at the hit). */
+int cdl_mts_add_material(cdl_mts_ctx *c, int line, const cdl_material *m, uint32_t *idx);
 /* A top-level or nested <texture>: scene texture (or -1) and value. */
 int cdl_mts_texture(cdl_mts_ctx *c, cdl_xml_node *n, int *tex, cdl_vec3 *value);
 /* An <emitter type="area"> inside a shape: the scene emitter. */

@@ -185,6 +185,31 @@ static int rel_ior(cdl_mts_ctx *c, cdl_xml_node *n, double int_def, float *eta)
     return 0;
 }
 
+/* A mesh attribute is read at the hit as a reflectance or a blend weight
+ * only: elsewhere its value is 1 (scene/attr.h). */
+static int reads_attr(const cdl_scene *s, int tex)
+{
+    if (tex >= 0 && s->texs[tex].type == CDL_TEX_SCALE)
+        tex = s->texs[tex].sub[0];
+    return tex >= 0 && s->texs[tex].type == CDL_TEX_ATTRIBUTE;
+}
+
+int cdl_mts_add_material(cdl_mts_ctx *c, int line, const cdl_material *m, uint32_t *idx)
+{
+    int slots[5 + CDL_PR_NPARAMS] = {m->maps.alpha_tex[0], m->maps.alpha_tex[1], m->maps.bump_tex,
+                                     m->maps.normal_tex, m->opacity_tex};
+    int n = 5;
+    if (m->type == CDL_MAT_PRINCIPLED)
+        for (int k = 0; k < CDL_PR_NPARAMS; k++)
+            slots[n++] = m->pr.tex[k];
+    for (int k = 0; k < n; k++)
+        if ((k < 4 ? m->maps.on : k == 4 ? m->masked : 1) && reads_attr(c->s, slots[k])) {
+            cdl_mts_warn(c, line, "a mesh_attribute is read as a reflectance or a blend weight only: 1 here");
+            break;
+        }
+    return cdl_mts_scene_rc(c, line, cdl_scene_add_material(c->s, m, idx, c->err));
+}
+
 int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat, int *found)
 {
     *found = 0;
@@ -332,7 +357,7 @@ static int mask(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : "mask");
     cdl_mts_warn_unused(c, n, "mask");
     uint32_t idx;
-    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+    if ((rc = cdl_mts_add_material(c, n->line, &m, &idx)))
         return rc;
     *mat = (int32_t)idx;
     return 0;
@@ -481,7 +506,7 @@ static int blend(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     const char *id = cdl_xml_attr_get(n, "id");
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : "blendbsdf");
     cdl_mts_warn_unused(c, n, "bsdf \"blendbsdf\"");
-    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+    if ((rc = cdl_mts_add_material(c, n->line, &m, &idx)))
         return rc;
     *mat = (int32_t)idx;
     return 0;
@@ -599,7 +624,7 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : type);
     cdl_mts_warn_unused(c, n, type);
     uint32_t idx;
-    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+    if ((rc = cdl_mts_add_material(c, n->line, &m, &idx)))
         return rc;
     *mat = (int32_t)idx;
     return 0;

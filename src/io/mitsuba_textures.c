@@ -298,7 +298,7 @@ int cdl_mts_perturbed_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, in
         m.maps.normal_tex = tex;
     }
     uint32_t idx;
-    if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &m, &idx, c->err))))
+    if ((rc = cdl_mts_add_material(c, n->line, &m, &idx)))
         return rc;
     *mat = (int32_t)idx;
     return 0;
