@@ -58,65 +58,6 @@ static int bdpt_prepare(void *self, const cdl_scene *scene, const cdl_options *o
     return st->tile_splats ? 0 : cdl_error_set(err, CDL_ERR_SYSTEM, "bdpt", 0, "out of memory");
 }
 
-/* s = 1 by resampling a light point for eye vertex pt (pbrt-v3 does the
- * same): next-event estimation's sampling (solid angle for spheres) gives
- * far less noise than the light subpath's y_0. The temporary vertex
- * carries 1 / (its actual density) as throughput but the light-path
- * origin density for MIS, so the weights stay a partition of unity. */
-static cdl_vec3 connect_resampled(const bdpt_state *st, const cdl_connect_ctx *cx,
-                                  const cdl_vertex_store *evs, uint32_t t, cdl_sampler *smp,
-                                  cdl_vertex_store *tmp, int only_infinite, uint64_t *rays)
-{
-    const cdl_scene *s = st->scene;
-    cdl_vec3 zero = cdl_v3(0.0f, 0.0f, 0.0f);
-    float us, ua, u1, u2, pmf;
-    smp->dim = 2 * t; /* same dimensions at the same depth in every pass: stays stratified */
-    cdl_sampler_2d(smp, &us, &ua);
-    cdl_sampler_2d(smp, &u1, &u2);
-    uint32_t pt = t - 1;
-    if (evs->flags[pt] & (CDL_V_DELTA | CDL_V_INFINITE))
-        return zero;
-    uint32_t li = cdl_alias_sample(&s->light_select, us, ua, &pmf);
-    const cdl_light *l = &s->lights[li];
-    cdl_light_sample ls;
-    if (!cdl_light_sample_li(l, evs->p[pt], u1, u2, &ls))
-        return zero;
-    cdl_vec3 n = cdl_v3(0.0f, 0.0f, 0.0f), Le = l->L;
-    float pdf_area = ls.pdf; /* delta lights: 1 */
-    int inf = cdl_light_at_infinity(l);
-    if (only_infinite && !inf)
-        return zero; /* shared light paths' y_0 cover the other lights */
-    if (inf) {
-        /* a point 2 R away along the sampled direction: the 1 / d^2 of the
-         * connection's G cancels in the throughput */
-        cdl_vec3 dd = cdl_sub(ls.p, evs->p[pt]);
-        float d2 = cdl_dot(dd, dd);
-        pdf_area = ls.pdf / d2;
-        Le = ls.Li;
-    } else if (l->type == CDL_LIGHT_TRIANGLE || l->type == CDL_LIGHT_SPHERE) {
-        n = l->type == CDL_LIGHT_TRIANGLE ? l->n : cdl_normalize(cdl_sub(ls.p, l->p));
-        if (l->type == CDL_LIGHT_SPHERE && l->inward)
-            n = cdl_neg(n);
-        float c = fabsf(cdl_dot(n, ls.wi));
-        pdf_area = ls.pdf * c / (ls.dist * ls.dist);
-    }
-    if (!(pdf_area > 0.0f))
-        return zero;
-    cdl_vs_clear(tmp);
-    tmp->n = 1;
-    tmp->p[0] = ls.p;
-    tmp->ng[0] = tmp->ns[0] = n;
-    tmp->wi[0] = zero;
-    tmp->beta[0] = cdl_scale(Le, 1.0f / (pmf * pdf_area));
-    tmp->pdf_fwd[0] = inf ? cdl_light_pdf_infinite(s, ls.wi) : cdl_light_pdf_origin(s, (int32_t)li);
-    tmp->pdf_rev[0] = 0.0f;
-    tmp->parent[0] = -1;
-    tmp->light[0] = (int32_t)li;
-    tmp->depth[0] = 0;
-    tmp->flags[0] = CDL_V_LIGHT | (cdl_light_is_delta(l) ? CDL_V_DELTA_LIGHT : 0) | (inf ? CDL_V_INFINITE : 0);
-    return cdl_connect(cx, evs, t, tmp, 0, 1, rays);
-}
-
 /* All strategies of one eye subpath against one light subpath (the light
  * path's vertices are light[0 .. nl), indices into lvs). */
 static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint32_t ne,
@@ -125,38 +66,9 @@ static cdl_vec3 combine(const bdpt_state *st, const cdl_vertex_store *evs, uint3
                         float splat_scale, cdl_sampler *resample, cdl_vertex_store *tmp,
                         uint64_t *rays)
 {
-    const cdl_scene *s = st->scene;
-    cdl_vec3 L = cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_connect_ctx cx = {s, &st->opt.camera, st->opt.mis, st->threshold, cnt, resample != NULL};
-    for (uint32_t t = 1; t <= ne; t++) {
-        for (uint32_t sidx = with_eye_only ? 0 : 1; sidx <= nl; sidx++) {
-            if (sidx + t < 2 || (int)(sidx + t) - 2 > st->opt.maxdepth)
-                continue;
-            if (t == 1) {
-                /* s = 1, t = 1 would repeat the light seen directly (s = 0, t = 2) */
-                if (sidx < 2 || !splats)
-                    continue;
-                float x, y;
-                cdl_vec3 c = cdl_connect_camera(&cx, lvs, l0, sidx, &x, &y, rays);
-                if (!cdl_is_black(c))
-                    cdl_splats_add_filtered(splats, &st->opt.camera.filter, st->opt.camera.width,
-                                            st->opt.camera.height, x, y, cdl_scale(c, splat_scale));
-                continue;
-            }
-            if (sidx == 0) {
-                if (with_eye_only)
-                    L = cdl_add(L, cdl_connect_eye_only(&cx, evs, t));
-                continue;
-            }
-            if (sidx == 1 && resample)
-                L = cdl_add(L, connect_resampled(st, &cx, evs, t, resample, tmp, 0, rays));
-            else if (sidx == 1 && (lvs->flags[l0] & CDL_V_INFINITE))
-                continue; /* no point light on the disk: resampled once per eye vertex instead */
-            else
-                L = cdl_add(L, cdl_connect(&cx, evs, t, lvs, l0, sidx, rays));
-        }
-    }
-    return L;
+    cdl_connect_ctx cx = {st->scene, &st->opt.camera, st->opt.mis, st->threshold, cnt, 0};
+    return cdl_connect_all(&cx, st->opt.maxdepth, evs, ne, lvs, l0, nl, with_eye_only, splats, splat_scale,
+                           resample, tmp, rays);
 }
 
 static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, int y1,
@@ -209,7 +121,7 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                     cdl_sampler_start(&rsmp, st->opt.sampler, st->opt.seed, pix + 2 * npix, pass);
                     cdl_connect_ctx cx = {st->scene, cam, st->opt.mis, st->threshold, &cnt, 0};
                     for (uint32_t t = 2; t <= ne && (int)t - 1 <= st->opt.maxdepth; t++)
-                        L = cdl_add(L, connect_resampled(st, &cx, &evs, t, &rsmp, &tvs, 1, rays));
+                        L = cdl_add(L, cdl_connect_resampled(&cx, &evs, t, &rsmp, &tvs, 1, rays));
                 }
                 cdl_vec3 Lc = cdl_v3(0.0f, 0.0f, 0.0f);
                 for (uint32_t k = set; k < lp->k; k += lp->sets)

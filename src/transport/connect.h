@@ -4,6 +4,8 @@
 #ifndef CDL_CONNECT_H
 #define CDL_CONNECT_H
 
+#include "core/sampler.h"
+#include "film/film.h"
 #include "scene/camera.h"
 #include "transport/mis.h"
 #include "transport/vertex_store.h"
@@ -29,6 +31,28 @@ cdl_vec3 cdl_connect(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uin
  * splat at raster (*x, *y) (already weighted), or black. */
 cdl_vec3 cdl_connect_camera(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0,
                             uint32_t s, float *x, float *y, uint64_t *rays);
+
+/* s = 1 by resampling a light point for eye vertex t-1 (pbrt-v3 does the
+ * same): next-event estimation's sampling (solid angle for spheres) gives
+ * far less noise than the light subpath's y_0. smp's dimensions 2t..2t+3
+ * are used (the same at the same depth in every pass: they stay
+ * stratified); tmp holds the temporary vertex (room for one).
+ * only_infinite: lights at infinity alone (shared light paths' y_0 cover
+ * the others). Weighted as cx says, shadow ray included. */
+cdl_vec3 cdl_connect_resampled(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t,
+                               cdl_sampler *smp, cdl_vertex_store *tmp, int only_infinite, uint64_t *rays);
+
+/* Every strategy of one eye subpath (evs[0 .. ne)) against one light
+ * subpath (lvs[l0 .. l0 + nl)) with at most maxdepth bounces: s = 0 when
+ * with_eye_only, light tracing (t = 1) when splats is given (splatted
+ * through cx->cam's filter, scaled by splat_scale), s = 1 by resampling
+ * the light when resample is given (tmp: its vertex), else from y_0 (not
+ * for lights at infinity, whose y_0 is no point). bdpt's inner loop, and
+ * vcm's connections. Returns the sum for the eye path's pixel. */
+cdl_vec3 cdl_connect_all(const cdl_connect_ctx *cx, int maxdepth, const cdl_vertex_store *evs, uint32_t ne,
+                         const cdl_vertex_store *lvs, uint32_t l0, uint32_t nl, int with_eye_only,
+                         cdl_splats *splats, float splat_scale, cdl_sampler *resample, cdl_vertex_store *tmp,
+                         uint64_t *rays);
 
 /* Normal of vertex i for cosines and densities: zero for the camera and
  * for point and spot lights. */
