@@ -106,14 +106,14 @@ static uint64_t bdpt_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                 cdl_sampler_start(&lsmp, st->opt.sampler, st->opt.seed, pix + npix, pass);
                 cdl_vs_clear(&lvs);
                 uint32_t nl = cdl_trace_light_subpath(st->scene, &st->walk, &lsmp, &lvs, rays);
-                cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+                cdl_mis_counts cnt = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f, 0.0f};
                 cdl_sampler rsmp;
                 cdl_sampler_start(&rsmp, st->opt.sampler, st->opt.seed, pix + 2 * npix, pass);
                 L = combine(st, &evs, ne, &lvs, 0, nl, &cnt, 1, splats, 1.0f, &rsmp, &tvs, rays);
             } else {
                 const cdl_light_pool *lp = &st->pool;
                 uint32_t set = cdl_light_pool_set(lp, x, y), m = cdl_light_pool_set_size(lp, set);
-                cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m, 1.0f, 0.0f};
+                cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, (float)m, 1.0f, 0.0f, 0.0f};
                 /* pure eye paths once, connections to each path of the set */
                 L = combine(st, &evs, ne, &lvs, 0, 0, &cnt, 1, NULL, 0.0f, NULL, NULL, rays);
                 if (st->at_infinity) { /* their s = 1: light sampling, once */
@@ -144,7 +144,7 @@ static void light_trace_pool(bdpt_state *st, cdl_film *film)
 {
     const cdl_light_pool *lp = &st->pool;
     uint64_t npix = (uint64_t)film->width * (uint64_t)film->height, rays = 0;
-    cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, 1.0f, 1.0f, 0.0f};
+    cdl_mis_counts cnt = {1.0f, (float)lp->k / (float)npix, 1.0f, 1.0f, 0.0f, 0.0f};
     float scale = (float)npix / (float)lp->k;
     int nbatch = 1024;
     cdl_vertex_store none;

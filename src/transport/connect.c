@@ -154,7 +154,7 @@ static float resample_pdf(const cdl_connect_ctx *cx, int32_t li, cdl_vec3 y, cdl
  * infinity: their s = 1 strategy may be sampled differently. */
 static cdl_mis_counts path_counts(const cdl_connect_ctx *cx, int at_inf)
 {
-    cdl_mis_counts n = cx->counts ? *cx->counts : (cdl_mis_counts){1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+    cdl_mis_counts n = cx->counts ? *cx->counts : (cdl_mis_counts){1.0f, 1.0f, 1.0f, 0.0f, 0.0f, 0.0f};
     n.connect_s1 = at_inf && n.s1_infinite > 0.0f ? n.s1_infinite : 0.0f;
     return n;
 }
@@ -409,4 +409,85 @@ cdl_vec3 cdl_connect_all(const cdl_connect_ctx *cx_in, int maxdepth, const cdl_v
         }
     }
     return L;
+}
+
+float cdl_merge_weight(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t, const cdl_bsdf *b,
+                       const cdl_vertex_store *lvs, uint32_t l0, uint32_t s)
+{
+    uint32_t pt = t - 1, qs = l0 + s - 1, n = t + s - 1;
+    if (t < 2 || s < 2 || n > MAX_PATH)
+        return 0.0f;
+    cdl_mis_vertex v[MAX_PATH];
+    /* eye records 0 .. t-1, then the light subpath's y_{s-2} .. y_0 (its
+     * y_{s-1} is the merge vertex, record t-1) */
+    fill_records(v, evs, t, lvs, l0, s - 1, 0);
+    cdl_vec3 x = evs->p[pt], wo = evs->wi[pt], wl = lvs->wi[qs];
+    v[pt].pdf_light = lvs->pdf_fwd[qs];
+    v[pt].delta = 0;
+    if (pt >= 2) /* z_{t-2} sampled from the merge vertex (along wo, as f sees it), light arriving along wl */
+        v[pt - 1].pdf_light = cdl_pdf_to_area(cdl_bsdf_pdf(b, wl, wo), x, evs->p[pt - 1], cdl_vertex_normal(evs, pt - 1));
+    /* y_{s-2} sampled from the merge vertex, the eye arriving along wo; at
+     * the light subpath's own distance, as its y_{s-1} lies there */
+    float pdf_sa = cdl_bsdf_pdf(b, wo, wl);
+    v[t].pdf_eye = (lvs->flags[qs - 1] & CDL_V_INFINITE)
+                       ? pdf_sa
+                       : cdl_pdf_to_area(pdf_sa, lvs->p[qs], lvs->p[qs - 1], cdl_vertex_normal(lvs, qs - 1));
+    v[n - 1].pdf_s1 = resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]);
+    int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
+    cdl_mis_counts c = path_counts(cx, (lvs->flags[l0] & CDL_V_INFINITE) != 0);
+    return cdl_mis_weight_merge(cx->mis, v, (int)n, (int)pt, delta_light, &c);
+}
+
+/* x^b of the heuristic, and pbrt's zero-density convention (the walk's) */
+static float hp(cdl_mis_kind kind, float x) { return kind == CDL_MIS_POWER ? x * x : x; }
+static float nz(float x) { return x != 0.0f ? x : 1.0f; }
+
+void cdl_merge_partials_eye(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t ne, float *b1,
+                            float *b2, float *ge)
+{
+    /* S(k) = X_{k-1} + H(k-2): the walk's eye-side terms of a merge at z_k
+     * (relative to the connection t = k), all but its last factor
+     * pl(z_{k-1}) / pe(z_{k-1}); X_i = connection t = i + merge at z_i */
+    cdl_mis_kind kd = cx->mis;
+    cdl_mis_counts c = path_counts(cx, 0);
+    float eta = c.merge, S = 0.0f;
+    for (uint32_t k = 1; k < ne; k++) {
+        int dk = (evs->flags[k] & CDL_V_DELTA) != 0, dp = (evs->flags[k - 1] & CDL_V_DELTA) != 0;
+        float here = hp(kd, eta * nz(evs->pdf_fwd[k]));
+        float term = hp(kd, k == 1 ? c.light_trace : c.connect);
+        b1[k] = dp ? 0.0f : term / here;
+        b2[k] = S / hp(kd, nz(evs->pdf_fwd[k - 1])) / here;
+        ge[k] = cdl_pdf_to_area(1.0f, evs->p[k], evs->p[k - 1], cdl_vertex_normal(evs, k - 1));
+        float X = (!dk && !dp ? term : 0.0f) + (!dk ? here : 0.0f);
+        float rho = k >= 2 ? hp(kd, nz(evs->pdf_rev[k - 1]) / nz(evs->pdf_fwd[k - 1])) : 0.0f;
+        S = X + rho * S;
+    }
+}
+
+void cdl_merge_partials_light(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0, uint32_t nl,
+                              float *a1, float *a2, float *gl)
+{
+    /* J(a): the walk's light-side terms beyond y_a (the connection cut
+     * between y_a and y_{a-1}, merges at y_1 .. y_a, and so on down to s =
+     * 0), relative to the light subpath ending at y_a */
+    cdl_mis_kind kd = cx->mis;
+    cdl_mis_counts c = path_counts(cx, (lvs->flags[l0] & CDL_V_INFINITE) != 0);
+    float eta = c.merge;
+    float pdf_s1 = nl >= 2 ? resample_pdf(cx, lvs->light[l0], lvs->p[l0], lvs->ng[l0], lvs->p[l0 + 1]) : 0.0f;
+    float q = pdf_s1 > 0.0f && lvs->pdf_fwd[l0] > 0.0f ? pdf_s1 / lvs->pdf_fwd[l0] : 1.0f;
+    int delta_light = (lvs->flags[l0] & CDL_V_DELTA_LIGHT) != 0;
+    float J = (lvs->flags[l0] & CDL_V_DELTA) || delta_light ? 0.0f : hp(kd, c.eye);
+    for (uint32_t a = 1; a < nl; a++) {
+        uint32_t i = l0 + a;
+        int da = (lvs->flags[i] & CDL_V_DELTA) != 0, dp = (lvs->flags[i - 1] & CDL_V_DELTA) != 0;
+        float here = hp(kd, eta * nz(lvs->pdf_fwd[i]));
+        float term = hp(kd, a == 1 ? (c.connect_s1 > 0.0f ? c.connect_s1 : c.connect) * q : c.connect);
+        a1[a] = dp ? 0.0f : term / here;
+        a2[a] = J / hp(kd, nz(lvs->pdf_fwd[i - 1])) / here;
+        gl[a] = (lvs->flags[i - 1] & CDL_V_INFINITE)
+                    ? 1.0f
+                    : cdl_pdf_to_area(1.0f, lvs->p[i], lvs->p[i - 1], cdl_vertex_normal(lvs, i - 1));
+        float sigma = hp(kd, nz(lvs->pdf_rev[i - 1]) / nz(lvs->pdf_fwd[i - 1]));
+        J = (!da && !dp ? term : 0.0f) + (!da ? here : 0.0f) + sigma * J;
+    }
 }

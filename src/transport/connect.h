@@ -54,6 +54,28 @@ cdl_vec3 cdl_connect_all(const cdl_connect_ctx *cx, int maxdepth, const cdl_vert
                          cdl_splats *splats, float splat_scale, cdl_sampler *resample, cdl_vertex_store *tmp,
                          uint64_t *rays);
 
+/* Vertex merging: the MIS weight of merging eye vertex t-1 (of evs, t >=
+ * 2, its BSDF b) with light vertex s-1 of the light path at l0 of lvs
+ * (s >= 2, within the merge radius): the full path is the eye subpath up
+ * to t-1 and the light subpath below s-1, the two merged vertices one.
+ * cx->counts->merge is eta (mis.h). */
+float cdl_merge_weight(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t t, const cdl_bsdf *b,
+                       const cdl_vertex_store *lvs, uint32_t l0, uint32_t s);
+
+/* The partial sums of cdl_mis_merge_partials (mis.h) along an eye
+ * subpath evs[0 .. ne): for each k in [1, ne), b1[k], b2[k] of merging
+ * at z_k, and ge[k] = |cos| / d^2 at z_{k-1} seen from z_k (1 / d^2 at
+ * the camera), which turns the merge's solid-angle density towards
+ * z_{k-1} into pl(z_{k-1}). */
+void cdl_merge_partials_eye(const cdl_connect_ctx *cx, const cdl_vertex_store *evs, uint32_t ne, float *b1,
+                            float *b2, float *ge);
+/* The same along a light subpath lvs[l0 .. l0 + nl): for each depth a in
+ * [1, nl), a1[a], a2[a] of merging at y_a, and gl[a] turning the merge's
+ * solid-angle density towards y_{a-1} into pe(y_{a-1}) (1 when y_{a-1} is
+ * at infinity, whose densities stay in solid angle). */
+void cdl_merge_partials_light(const cdl_connect_ctx *cx, const cdl_vertex_store *lvs, uint32_t l0, uint32_t nl,
+                              float *a1, float *a2, float *gl);
+
 /* Normal of vertex i for cosines and densities: zero for the camera and
  * for point and spot lights. */
 cdl_vec3 cdl_vertex_normal(const cdl_vertex_store *vs, uint32_t i);

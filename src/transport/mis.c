@@ -55,13 +55,15 @@ float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, i
      * its density enters that one strategy only */
     int L = s + t - 1;
     float q = v[L].pdf_s1 > 0.0f && v[L].pdf_light > 0.0f ? v[L].pdf_s1 / v[L].pdf_light : 1.0f;
-    float here = count(n, s, t) * (s == 1 ? q : 1.0f), sum = 0.0f, r = 1.0f;
+    float here = count(n, s, t) * (s == 1 ? q : 1.0f), sum = 0.0f, r = 1.0f, eta = n->merge;
 #define CORR(sp, tp) hpow(count(n, sp, tp) * ((sp) == 1 ? q : 1.0f) / here, pw)
     /* moving the connection towards the camera: fewer eye vertices */
     for (int i = t - 1; i > 0; i--) {
         r *= hpow(remap0(v[i].pdf_light) / remap0(v[i].pdf_eye), pw);
         if (!v[i].delta && !v[i - 1].delta)
             sum += r * CORR(s + t - i, i);
+        if (eta > 0.0f && i < L && !v[i].delta) /* merging at z_i: (t = i) x pe(z_i) eta */
+            sum += r * hpow(eta * remap0(v[i].pdf_eye) / here, pw);
     }
     /* towards the light: fewer light vertices */
     r = 1.0f;
@@ -70,7 +72,43 @@ float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, i
         int delta_prev = i + 1 < s + t ? v[i + 1].delta : delta_light;
         if (!v[i].delta && !delta_prev)
             sum += r * CORR(s + t - i - 1, i + 1);
+        if (eta > 0.0f && i < L && !v[i].delta) /* merging at z_i: (t = i + 1) x pl(z_i) eta */
+            sum += r * hpow(eta * remap0(v[i].pdf_light) / here, pw);
     }
 #undef CORR
     return 1.0f / (1.0f + sum);
+}
+
+float cdl_mis_weight_merge(cdl_mis_kind kind, const cdl_mis_vertex *v, int n, int k, int delta_light,
+                           const cdl_mis_counts *c)
+{
+    int pw = kind == CDL_MIS_POWER, L = n - 1;
+    float eta = c->merge;
+    if (!(eta > 0.0f) || k < 1 || k >= L)
+        return 0.0f;
+    float q = v[L].pdf_s1 > 0.0f && v[L].pdf_light > 0.0f ? v[L].pdf_s1 / v[L].pdf_light : 1.0f;
+    /* every term relative to the connection (t = k): eye subpath z_0 ..
+     * z_{k-1}, light subpath z_k .. z_L; this merge is that times pe(z_k) eta */
+    float here = hpow(eta * remap0(v[k].pdf_eye), pw), sum = here, r = 1.0f;
+#define TERM(sp, tp) hpow(count(c, sp, tp) * ((sp) == 1 ? q : 1.0f), pw)
+    if (!v[k].delta && !v[k - 1].delta)
+        sum += TERM(n - k, k);
+    for (int i = k - 1; i > 0; i--) { /* fewer eye vertices: r = (t = i) / (t = k) */
+        r *= hpow(remap0(v[i].pdf_light) / remap0(v[i].pdf_eye), pw);
+        if (!v[i].delta && !v[i - 1].delta)
+            sum += r * TERM(n - i, i);
+        if (!v[i].delta)
+            sum += r * hpow(eta * remap0(v[i].pdf_eye), pw);
+    }
+    r = 1.0f;
+    for (int i = k; i < n; i++) { /* fewer light vertices: r = (t = i + 1) / (t = k) */
+        r *= hpow(remap0(v[i].pdf_eye) / remap0(v[i].pdf_light), pw);
+        int delta_prev = i + 1 < n ? v[i + 1].delta : delta_light;
+        if (!v[i].delta && !delta_prev)
+            sum += r * TERM(L - i, i + 1);
+        if (i > k && i < L && !v[i].delta)
+            sum += r * hpow(eta * remap0(v[i].pdf_light), pw);
+    }
+#undef TERM
+    return here / sum;
 }

@@ -34,6 +34,7 @@ typedef struct cdl_mis_counts {
                         * light paths those are resampled once per eye vertex (bdpt sets
                         * 1); 0: as connect */
     float connect_s1;  /* the s = 1 count in effect for this path (connect.c sets it); 0: connect */
+    float merge;       /* vertex merging's eta = pi r^2 N (N light paths searched per merge); 0: none */
 } cdl_mis_counts;
 
 /* Weight of strategy (s, t) for the full path v[0 .. s+t-1].
@@ -41,5 +42,34 @@ typedef struct cdl_mis_counts {
  * threshold: the stratification heuristic's t. */
 float cdl_mis_weight(cdl_mis_kind kind, const cdl_mis_vertex *v, int s, int t, int delta_light,
                      const cdl_mis_counts *n, float threshold);
+
+/* Weight of merging at vertex k (1 <= k <= s + t - 2) of the full path
+ * v[0 .. n) (balance or power heuristic; n->merge > 0). v[k] is the merge
+ * vertex: pdf_eye its density from the eye subpath, pdf_light from the
+ * light subpath; records k - 1 and k + 1 hold the densities through the
+ * merge (the eye vertex's BSDF sampling towards the light subpath's
+ * previous vertex, and back). */
+float cdl_mis_weight_merge(cdl_mis_kind kind, const cdl_mis_vertex *v, int n, int k, int delta_light,
+                           const cdl_mis_counts *c);
+
+/* The same weight in O(1) from partial sums of each subpath's walk
+ * (SmallVCM's dVCM, dVC, dVM in this walk's terms; connect.h's
+ * cdl_merge_partials_* compute them once per vertex): merging eye vertex
+ * z_k with light vertex y_m,
+ *   w = 1 / (1 + a1 + pe(y_{m-1})^b a2 + b1 + pl(z_{k-1})^b b2)
+ * where (a1, a2) belong to y_m, (b1, b2) to z_k, b = 2 (power) or 1
+ * (balance), and the two densities are those through the merge (area
+ * measure: the eye vertex's BSDF sampling y_{m-1}, and z_{k-1} for light
+ * arriving from y_{m-1}); zero densities count as 1, as in the walk. */
+static inline float cdl_mis_merge_partials(cdl_mis_kind kind, float a1, float a2, float pe_light_prev, float b1,
+                                           float b2, float pl_eye_prev)
+{
+    float x = pe_light_prev != 0.0f ? pe_light_prev : 1.0f, y = pl_eye_prev != 0.0f ? pl_eye_prev : 1.0f;
+    if (kind == CDL_MIS_POWER) {
+        x *= x;
+        y *= y;
+    }
+    return 1.0f / (1.0f + a1 + x * a2 + b1 + y * b2);
+}
 
 #endif
