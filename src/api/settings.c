@@ -86,8 +86,8 @@ static int set(cdl_settings *s, const char *name, const char *v, cdl_error *err)
     const cdl_param *p = cdl_param_find(&cdl_common_table, name);
     if (p) {
         if (!strcmp(name, "integrator") && v && !cdl_integrator_find(v))
-            return cdl_error_set(err, CDL_ERR_USAGE, name, 0, "unknown integrator '%s' (path, bdpt, ir, rigi, pm, gkde "
-                                 "or splat)", v);
+            return cdl_error_set(err, CDL_ERR_USAGE, name, 0, "unknown integrator '%s' (path, bdpt, ir, rigi, pm, gkde, "
+                                 "splat or vcm)", v);
         int rc = cdl_param_set(p, v, &s->c, err);
         if (!rc)
             s->given_common |= 1u << (p - cdl_common_table.rows);

@@ -22,7 +22,7 @@ static const char *define_text(const char *v)
 }
 
 static const cdl_param rows[] = {
-    {"integrator", CDL_PARAM_NAME, "NAME", "path", "light transport method (path, bdpt, ir, rigi, pm, gkde, splat)",
+    {"integrator", CDL_PARAM_NAME, "NAME", "path", "light transport method (path, bdpt, ir, rigi, pm, gkde, splat, vcm)",
      .count = sizeof(((cdl_common_params *)0)->integrator), .at = offsetof(cdl_common_params, integrator)},
     {"spp", CDL_PARAM_INT, "N", "64", "samples per pixel, one per pass (a pbrt scene's sampler may set it)", 1, 1e6,
      AT(spp)},

@@ -90,6 +90,13 @@ typedef struct cdl_splat_options {
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;
 
+/* vcm: vertex connection and merging (Georgiev et al. 2012) */
+typedef struct cdl_vcm_options {
+    float radius;   /* merge radius of the first pass; <= 0: from the pixel footprint */
+    int mode;       /* full, connect (bdpt) or merge (merging alone) */
+    int visibility; /* merges test visibility with a shadow ray */
+} cdl_vcm_options;
+
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 /* extra image layers (cdl_options.aov bits) */
@@ -124,6 +131,7 @@ typedef struct cdl_options {
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;
+    cdl_vcm_options vcm;
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the
