@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Does each biased method converge to the right image? pm, gkde and splat at
+# Does each biased method converge to the right image? pm, gkde, splat and vcm at
 # T, 4T and 16T on the realistic interiors against long path references:
 # block-median ratio, relMSE, log-log plots (bench/consistency.py --help).
 # usage: bench/consistency.sh [--build DIR] [consistency.py options]

@@ -33,4 +33,6 @@ rigi|
 ir|
 gkde|
 splat|
+vcm|
+vcm|--vcm-mode merge
 EOT

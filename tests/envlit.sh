@@ -7,7 +7,9 @@
 # within 2 % in the mean (its footprint bias on the indirect light), splat
 # within 2 % in the mean (measured 0.996 at 16 passes) and its indirect light
 # alone within 6 % (--direct none less its sky, against path less path at
-# --maxdepth 1: measured 0.967, the kernels' bias, 0.975 at 64 passes).
+# --maxdepth 1: measured 0.967, the kernels' bias, 0.975 at 64 passes);
+# vcm at 32 passes within 1 % (measured 0.9992) and its merging alone
+# within 2 % (0.9996).
 #   envlit.sh CANDELA SCENE
 set -u
 candela=$1 scene=$2
@@ -26,6 +28,8 @@ done
 "$candela" render "$scene" -i splat --spp 16 -q -o "$tmp/splat.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i splat --spp 16 --direct none -q -o "$tmp/splatind.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i splat --maxdepth 1 --direct none --spp 16 -q -o "$tmp/sky.exr" >/dev/null || exit 1
+"$candela" render "$scene" -i vcm --spp 32 -q -o "$tmp/vcm.exr" >/dev/null || exit 1
+"$candela" render "$scene" -i vcm --vcm-mode merge --spp 32 -q -o "$tmp/vcmm.exr" >/dev/null || exit 1
 d16=$("$candela" diff "$tmp/bdpt16.exr" "$tmp/path.exr")
 d64=$("$candela" diff "$tmp/bdpt64.exr" "$tmp/path.exr")
 dpm=$("$candela" diff "$tmp/pm.exr" "$tmp/path.exr")
@@ -34,6 +38,8 @@ r16=$(echo "$d16" | key relmse) r64=$(echo "$d64" | key relmse)
 m64=$(echo "$d64" | key mean_ratio) mpm=$(echo "$dpm" | key mean_ratio)
 mgk=$("$candela" diff "$tmp/gkde.exr" "$tmp/path.exr" | key mean_ratio)
 msp=$("$candela" diff "$tmp/splat.exr" "$tmp/path.exr" | key mean_ratio)
+mvc=$("$candela" diff "$tmp/vcm.exr" "$tmp/path.exr" | key mean_ratio)
+mvm=$("$candela" diff "$tmp/vcmm.exr" "$tmp/path.exr" | key mean_ratio)
 mean() { "$candela" diff "$1" "$tmp/path.exr" | sed -n 's/.*mean test \([^,]*\),.*/\1/p'; }
 # indirect light: splat's without direct light and sky, path's beyond one bounce
 ind=$(awk -v p="$(mean "$tmp/path.exr")" -v p1="$(mean "$tmp/path1.exr")" -v s="$(mean "$tmp/splatind.exr")" \
@@ -46,4 +52,6 @@ check "$msh > 0.99 && $msh < 1.01" "bdpt with 256 shared light paths in 4 x 4 se
 check "$mgk > 0.98 && $mgk < 1.02" "gkde 16 passes / path 1024: mean $mgk (within 2 %)"
 check "$msp > 0.98 && $msp < 1.02" "splat 16 passes / path 1024: mean $msp (within 2 %)"
 check "$ind > 0.94 && $ind < 1.06" "splat's indirect light / path's, 16 passes: $ind (within 6 %)"
+check "$mvc > 0.99 && $mvc < 1.01" "vcm 32 passes / path 1024: mean $mvc (within 1 %)"
+check "$mvm > 0.98 && $mvm < 1.02" "vcm merging alone, 32 passes / path 1024: mean $mvm (within 2 %)"
 exit $fail

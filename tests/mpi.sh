@@ -5,7 +5,8 @@
 #    difference <= 1e-5); gkde's trial-link plans, which adapt to earlier
 #    steps, are kept equal by summing its tallies at each fold (and 3 ranks);
 #  - two 2-rank runs are bit-identical (every method);
-#  - shared light paths (rigi, bdpt --light-paths) are per pass and rank;
+#  - shared light paths (rigi, bdpt --light-paths) are per pass and rank,
+#    and so are vcm's light paths and merge radius (by the global pass index);
 #  - --time is the whole job's budget;
 #  - a bad scene: one error line, a non-zero exit;
 #  - SIGINT to mpirun: the ranks stop, rank 0 writes the passes done;
@@ -61,6 +62,7 @@ d=$("$maxrel" "$tmp/g3.exr" "$tmp/one.exr")
 if awk -v d="$d" 'BEGIN {exit !(d <= 1e-5)}'; then ok "gkde: 3 ranks vs 1 process, max relative difference $d"
 else bad "gkde: 3 ranks vs 1 process, max relative difference $d (> 1e-5)"; fi
 check splat 3 -i splat --photons 20000
+check vcm 4 -i vcm
 head -1 "$tmp/a.out"
 
 # --time is the job's budget: every rank stops within it

@@ -136,7 +136,7 @@ static void test_images(const cdl_scene *a, const cdl_scene *b, const cdl_camera
 {
     /* not splat: on the instanced scene its pass takes minutes (against 0.4 s
      * on the copies), in its occlusion test's packets; left for later */
-    static const char *const methods[] = {"path", "bdpt", "ir", "rigi", "pm", "gkde"};
+    static const char *const methods[] = {"path", "bdpt", "ir", "rigi", "pm", "gkde", "vcm"};
     for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++) {
         cdl_options opt;
         cdl_options_default(&opt);

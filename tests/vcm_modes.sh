@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# vcm's two halves on the McGuire Cornell box:
+#  - vcm_mode connect is bdpt: the same light paths, the same strategies and
+#    weights (eta = 0), so the same pixels (max relative difference <= 1e-6);
+#  - vcm_mode merge (merging alone, a progressive photon mapper over the same
+#    light paths) converges to the reference: from N to 4N passes the median
+#    of the 16x16 block ratios moves towards 1 (or is within 1 % already) and
+#    the relative MSE falls.
+# (Full vcm against the reference: reference.sh.)
+# usage: vcm_modes.sh CANDELA IMAGE_MAXREL REF.exr N -- SCENE render args...
+set -u
+candela=$1 maxrel=$2 ref=$3 n=$4
+shift 5
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+ok() { echo "ok  : $*"; }
+bad() { echo "FAIL: $*"; fail=1; }
+key() { "$candela" diff "$1" "$ref" | tr -s ' ' '\n' | awk -v k="$2" 'p {print; exit} $0 == k {p = 1}'; }
+render() { # out args...
+  local out=$1
+  shift
+  "$candela" render "$@" -q -o "$out" >/dev/null || { bad "render $* exited $?"; exit 1; }
+}
+
+# connect vs bdpt: small and quick, every strategy incl. light tracing
+render "$tmp/bdpt.exr" "$@" -i bdpt --res 64x64 --spp 4 --seed 3
+render "$tmp/vc.exr" "$@" -i vcm --vcm-mode connect --res 64x64 --spp 4 --seed 3
+d=$("$maxrel" "$tmp/vc.exr" "$tmp/bdpt.exr")
+if awk -v d="$d" 'BEGIN {exit !(d <= 1e-6)}'; then ok "vcm connect = bdpt: max relative difference $d"
+else bad "vcm connect vs bdpt: max relative difference $d (> 1e-6)"; fi
+
+# merge alone: bias shrinking with the passes (one render, snapshots at N and 4N
+# would need the API; two renders with the same seed share their first N passes)
+render "$tmp/m1.exr" "$@" -i vcm --vcm-mode merge --spp "$n" --seed 1
+render "$tmp/m4.exr" "$@" -i vcm --vcm-mode merge --spp $((4 * n)) --seed 1
+b1=$(key "$tmp/m1.exr" block_median_ratio) b4=$(key "$tmp/m4.exr" block_median_ratio)
+e1=$(key "$tmp/m1.exr" relmse) e4=$(key "$tmp/m4.exr" relmse)
+if awk -v a="$b1" -v b="$b4" 'BEGIN {da = a > 1 ? a - 1 : 1 - a; db = b > 1 ? b - 1 : 1 - b; exit !(db < da || db < 0.01)}'; then
+  ok "vcm merge: block median $b1 at $n passes, $b4 at $((4 * n)) (towards 1, or within 1 %)"
+else
+  bad "vcm merge: block median $b1 at $n passes, $b4 at $((4 * n)) (moved away from 1)"
+fi
+if awk -v a="$e1" -v b="$e4" 'BEGIN {exit !(b < a)}'; then ok "vcm merge: relMSE $e1 -> $e4"
+else bad "vcm merge: relMSE $e1 -> $e4 (did not fall)"; fi
+
+exit $fail
