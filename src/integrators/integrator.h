@@ -100,7 +100,7 @@ typedef struct cdl_vcm_options {
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 /* extra image layers (cdl_options.aov bits) */
-enum { CDL_AOV_PATHLENGTH = 1, CDL_AOV_STRATA = 2, CDL_AOV_BANDWIDTH = 4, CDL_AOV_RECORDS = 8 };
+enum { CDL_AOV_PATHLENGTH = 1, CDL_AOV_STRATA = 2, CDL_AOV_BANDWIDTH = 4, CDL_AOV_RECORDS = 8, CDL_AOV_MERGE = 16 };
 
 typedef struct cdl_options {
     cdl_camera camera;
@@ -142,7 +142,7 @@ float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt);
 void cdl_options_default(cdl_options *o);
 
 /* Rows shared by several methods (each lists the tables it reads):
- * progressive and alpha (pm, gkde, splat), photons (pm, splat), light
+ * progressive and alpha (pm, gkde, splat, vcm), photons (pm, splat), light
  * paths, interleave and threshold (bdpt, ir, rigi), shadow_mode (ir,
  * rigi, gkde). */
 extern const cdl_param_table cdl_density_table, cdl_photon_table, cdl_light_path_table, cdl_shadow_table;
