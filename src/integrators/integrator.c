@@ -14,10 +14,12 @@ extern const cdl_integrator_vtbl cdl_rigi_integrator;
 extern const cdl_integrator_vtbl cdl_pm_integrator;
 extern const cdl_integrator_vtbl cdl_gkde_integrator;
 extern const cdl_integrator_vtbl cdl_splat_integrator;
+extern const cdl_integrator_vtbl cdl_sppm_integrator;
 
 static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
                                                  &cdl_ir_integrator, &cdl_rigi_integrator,
-                                                 &cdl_pm_integrator, &cdl_gkde_integrator, &cdl_splat_integrator, NULL};
+                                                 &cdl_pm_integrator, &cdl_gkde_integrator, &cdl_splat_integrator,
+                                                 &cdl_sppm_integrator, NULL};
 
 #define AT(f) CDL_PARAM_AT(cdl_options, f)
 

@@ -90,6 +90,13 @@ typedef struct cdl_splat_options {
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;
 
+/* sppm: stochastic progressive photon mapping (Hachisuka & Jensen 2009) */
+typedef struct cdl_sppm_options {
+    float radius;     /* initial radius of every pixel's disc; <= 0: radius_px pixel footprints */
+    float radius_px;  /* that default, in pixel footprints at the pixel's first visible point */
+    int visibility;   /* leave out photons no free path joins to the visible point (a shadow ray each) */
+} cdl_sppm_options;
+
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 /* extra image layers (cdl_options.aov bits) */
@@ -124,6 +131,7 @@ typedef struct cdl_options {
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;
+    cdl_sppm_options sppm;
 } cdl_options;
 
 /* The threshold t actually used: opt->threshold, or one that limits the
