@@ -204,9 +204,9 @@ static void sppm_destroy(void *self)
 static const cdl_param rows[] = {
     {"radius", CDL_PARAM_FLOAT, "R", "", "initial radius of every pixel's photon disc in scene units (default: "
      "radius_px pixel footprints at the pixel's first visible point)", 1e-9, 1e9, AT(radius)},
-    {"radius_px", CDL_PARAM_FLOAT, "P", "3", "the default initial radius in pixel footprints", 1e-3, 1e4,
+    {"radius_px", CDL_PARAM_FLOAT, "P", "1", "the default initial radius in pixel footprints", 1e-3, 1e4,
      AT(radius_px)},
-    {"photon_visibility", CDL_PARAM_BOOL, "on|off", "off", "leave out photons no free path joins to the visible "
+    {"photon_visibility", CDL_PARAM_BOOL, "on|off", "on", "leave out photons no free path joins to the visible "
      "point (a shadow ray each; without, light leaks near a wall's foot until the radius shrinks past it)",
      AT(visibility)},
 };
