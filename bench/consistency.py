@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Does each biased method converge to the right image? (issue 25)
 
-Renders every density-estimation method (pm, gkde, splat, vcm, at their defaults
+Renders every density-estimation method (pm, gkde, splat, sppm, vcm, at their defaults
 unless --config says otherwise) on realistic interiors at T, 4T and 16T
 seconds (snapshots of one progressive render: the same passes a longer
 render would start with) and compares each snapshot with a long `path`
@@ -100,7 +100,7 @@ def main():
     ap.add_argument("--scenes", default=",".join(n for n in SCENES if not SCENES[n][3]),
                     help="comma-separated (default: all but the sealed rooms, whose test is tests/consistency.py)")
     ap.add_argument("--config", action="append", default=[],
-                    help="NAME=ARGS, e.g. 'pm=-i pm' (default: pm, gkde, splat, vcm at their defaults); repeatable")
+                    help="NAME=ARGS, e.g. 'pm=-i pm' (default: pm, gkde, splat, sppm, vcm at their defaults); repeatable")
     ap.add_argument("--time", type=float, default=12.0, help="T in seconds (snapshots at T, 4T, 16T)")
     ap.add_argument("--factors", default="1,4,16", help="snapshot times as multiples of T")
     ap.add_argument("--res", default="160x120")
@@ -134,7 +134,7 @@ def main():
 
     w, h = (int(v) for v in a.res.split("x"))
     configs = [c.split("=", 1) for c in a.config] or [["pm", "-i pm"], ["gkde", "-i gkde"], ["splat", "-i splat"],
-                                                  ["vcm", "-i vcm"]]
+                                                         ["sppm", "-i sppm"], ["vcm", "-i vcm"]]
     factors = [float(f) for f in a.factors.split(",")]
     refs = a.refs or os.path.join(a.out, "refs")
     os.makedirs(refs, exist_ok=True)

@@ -20,7 +20,7 @@ echo "## Defaults on the default scene (Cornell box 256x256, $spp passes, $(npro
 echo
 echo "| method | s per pass | $spp passes (s) | relMSE | mean ratio |"
 echo "|---|---|---|---|---|"
-for m in path bdpt ir rigi pm gkde splat vcm; do
+for m in path bdpt ir rigi pm gkde splat sppm vcm; do
   # shellcheck disable=SC2086
   line=$("$candela" render "$scene" $cam -i "$m" --spp "$spp" -q -o "$tmp/$m.exr")
   secs=$(echo "$line" | sed -n 's/.* spp in \([0-9.]*\) s.*/\1/p')

@@ -4,7 +4,8 @@
 # bdpt at N and 4N passes against path at 1024 (mean within 1 %, relMSE
 # falling at least 2.5x for 4x the passes: 1/N with the reference's own
 # noise), bdpt with shared light paths within 1 %, pm within 3 % and gkde
-# within 2 % in the mean (its footprint bias on the indirect light), splat
+# within 2 % in the mean (its footprint bias on the indirect light), sppm
+# within 2 %, splat
 # within 2 % in the mean (measured 0.996 at 16 passes) and its indirect light
 # alone within 6 % (--direct none less its sky, against path less path at
 # --maxdepth 1: measured 0.967, the kernels' bias, 0.975 at 64 passes);
@@ -24,6 +25,7 @@ done
 "$candela" render "$scene" -i pm --spp 32 -q -o "$tmp/pm.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i bdpt --light-paths 256 --interleave 4 --spp 64 -q -o "$tmp/shared.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i gkde --spp 16 -q -o "$tmp/gkde.exr" >/dev/null || exit 1
+"$candela" render "$scene" -i sppm --spp 16 -q -o "$tmp/sppm.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i path --spp 1024 --maxdepth 1 -q -o "$tmp/path1.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i splat --spp 16 -q -o "$tmp/splat.exr" >/dev/null || exit 1
 "$candela" render "$scene" -i splat --spp 16 --direct none -q -o "$tmp/splatind.exr" >/dev/null || exit 1
@@ -37,6 +39,7 @@ msh=$("$candela" diff "$tmp/shared.exr" "$tmp/path.exr" | key mean_ratio)
 r16=$(echo "$d16" | key relmse) r64=$(echo "$d64" | key relmse)
 m64=$(echo "$d64" | key mean_ratio) mpm=$(echo "$dpm" | key mean_ratio)
 mgk=$("$candela" diff "$tmp/gkde.exr" "$tmp/path.exr" | key mean_ratio)
+mss=$("$candela" diff "$tmp/sppm.exr" "$tmp/path.exr" | key mean_ratio)
 msp=$("$candela" diff "$tmp/splat.exr" "$tmp/path.exr" | key mean_ratio)
 mvc=$("$candela" diff "$tmp/vcm.exr" "$tmp/path.exr" | key mean_ratio)
 mvm=$("$candela" diff "$tmp/vcmm.exr" "$tmp/path.exr" | key mean_ratio)
@@ -50,6 +53,7 @@ check "$r16 / $r64 > 2.5" "bdpt relMSE against path: $r16 at 16 passes, $r64 at 
 check "$mpm > 0.97 && $mpm < 1.03" "pm 32 passes / path 1024: mean $mpm (within 3 %)"
 check "$msh > 0.99 && $msh < 1.01" "bdpt with 256 shared light paths in 4 x 4 sets, 64 passes / path 1024: mean $msh (within 1 %)"
 check "$mgk > 0.98 && $mgk < 1.02" "gkde 16 passes / path 1024: mean $mgk (within 2 %)"
+check "$mss > 0.98 && $mss < 1.02" "sppm 16 passes / path 1024: mean $mss (within 2 %; 0.9997 measured at 32)"
 check "$msp > 0.98 && $msp < 1.02" "splat 16 passes / path 1024: mean $msp (within 2 %)"
 check "$ind > 0.94 && $ind < 1.06" "splat's indirect light / path's, 16 passes: $ind (within 6 %)"
 check "$mvc > 0.99 && $mvc < 1.01" "vcm 32 passes / path 1024: mean $mvc (within 1 %)"

@@ -14,7 +14,7 @@ fail=0
 ratio() { "$candela" diff "$1" "$2" | tr -s ' ' '\n' | awk 'p {print; exit} $0 == "mean_ratio" {p = 1}'; }
 for md in $depths; do
   "$candela" render "$@" --maxdepth "$md" -i path --spp 1024 -q -o "$tmp/path.exr" >/dev/null || { echo "FAIL: path at --maxdepth $md"; exit 1; }
-  for m in "bdpt --spp 128" "rigi --spp 8" "ir --spp 8" "pm --spp 16" "vcm --spp 64"; do
+  for m in "bdpt --spp 128" "rigi --spp 8" "ir --spp 8" "pm --spp 16" "sppm --spp 32" "vcm --spp 64"; do
     i=${m%% *}
     # shellcheck disable=SC2086 # the method's options are split on purpose
     "$candela" render "$@" --maxdepth "$md" -i $m -q -o "$tmp/$i.exr" >/dev/null || { echo "FAIL: $i at --maxdepth $md exited $?"; fail=1; continue; }

@@ -5,6 +5,7 @@
 #    difference <= 1e-5); gkde's trial-link plans, which adapt to earlier
 #    steps, are kept equal by summing its tallies at each fold (and 3 ranks);
 #  - two 2-rank runs are bit-identical (every method);
+#  - sppm, whose statistics are per rank: 2 ranks within 2 % of 1 process;
 #  - shared light paths (rigi, bdpt --light-paths) are per pass and rank,
 #    and so are vcm's light paths and merge radius (by the global pass index);
 #  - --time is the whole job's budget;
@@ -64,6 +65,22 @@ else bad "gkde: 3 ranks vs 1 process, max relative difference $d (> 1e-5)"; fi
 check splat 3 -i splat --photons 20000
 check vcm 4 -i vcm
 head -1 "$tmp/a.out"
+
+# sppm's per-pixel statistics run through the passes in order: each rank
+# keeps its own (passes r, r + N, ...), so 2 ranks give another consistent
+# estimate, not the same sums: the image mean within 2 %, two 2-rank runs
+# bit-identical
+# shellcheck disable=SC2086
+"$candela" render "$scene" $cam --spp 8 -i sppm --photons 20000 -o "$tmp/s1.exr" >/dev/null 2>&1 || bad "sppm: 1 process"
+for r in a b; do
+  # shellcheck disable=SC2086
+  $mpi "$candela" render "$scene" $cam --spp 8 -i sppm --photons 20000 -o "$tmp/s$r.exr" >/dev/null 2>&1 || bad "sppm: 2 ranks"
+done
+m=$("$candela" diff "$tmp/sa.exr" "$tmp/s1.exr" | tr -s ' ' '\n' | awk 'p {print; exit} $0 == "mean_ratio" {p = 1}')
+if awk -v m="$m" 'BEGIN {exit !(m > 0.98 && m < 1.02)}'; then ok "sppm: 2 ranks / 1 process, image mean $m"
+else bad "sppm: 2 ranks / 1 process, image mean $m (not within 2 %)"; fi
+same=$("$maxrel" "$tmp/sa.exr" "$tmp/sb.exr")
+if [ "$same" = 0 ]; then ok "sppm: two 2-rank runs bit-identical"; else bad "sppm: two 2-rank runs differ by $same"; fi
 
 # --time is the job's budget: every rank stops within it
 # shellcheck disable=SC2086

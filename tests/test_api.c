@@ -120,10 +120,10 @@ int main(int argc, char **argv)
     for (int i = 0; i < cdl_option_count(); i++) {
         const cdl_option_info *o = cdl_option_get(i);
         CHECK(o->name[0] && o->help[0] && o->section[0], "option %d incomplete", i);
-        found += !strcmp(o->name, "photons") && !strcmp(o->integrators, "pm,splat") && !strcmp(o->default_value, "200000");
+        found += !strcmp(o->name, "photons") && !strcmp(o->integrators, "pm,splat,sppm") && !strcmp(o->default_value, "200000");
     }
     CHECK(found == 1 && !cdl_option_get(-1) && !cdl_option_get(cdl_option_count()), "option table");
-    CHECK(cdl_integrator_count() == 7 && !strcmp(cdl_integrator_name(0), "path") && !cdl_integrator_name(7),
+    CHECK(cdl_integrator_count() == 9 && !strcmp(cdl_integrator_name(0), "path") && !cdl_integrator_name(9),
           "integrators: %d", cdl_integrator_count());
 
     /* scenes: errors name the file and the line */

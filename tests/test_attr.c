@@ -78,13 +78,9 @@ static int hit_at(const cdl_scene *s, float x, float y, cdl_surface *sf)
 
 static int load(const char *name, cdl_scene *s, cdl_error *err)
 {
-    char path[512];
     cdl_scene_settings set;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    int rc = cdl_scene_init(s, path, err);
-    if (!rc && (rc = cdl_scene_load(s, path, &set, err)))
-        cdl_scene_free(s);
-    if (!rc && (rc = cdl_scene_commit(s, err)))
+    int rc = test_load(dir, name, s, &set, err);
+    if (rc)
         cdl_scene_free(s);
     return rc;
 }

@@ -30,20 +30,7 @@ static void write_file(const char *name, const char *text)
 /* Loads dir/name; prints and returns the status. */
 static int load(const char *name, cdl_scene *s, cdl_scene_settings *set, cdl_error *err)
 {
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    cdl_scene_settings_init(set);
-    int rc = cdl_scene_init(s, path, err);
-    if (!rc)
-        rc = cdl_load_pbrt(s, path, set, err);
-    if (!rc)
-        rc = cdl_scene_commit(s, err);
-    if (rc) {
-        char buf[2048];
-        cdl_error_format(err, buf, sizeof buf);
-        printf("      load %s: %s\n", name, buf);
-    }
-    return rc;
+    return test_load(dir, name, s, set, err);
 }
 
 static cdl_vec3 vert(const cdl_scene *s, uint32_t i)

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 
 #include "integrators/integrator.h"
+#include "io/loader.h"
+#include "io/settings.h"
 #include "scene/scene.h"
 
 static int test_failures = 0;
@@ -30,6 +32,27 @@ static inline void test_write(const char *dir, const char *name, const void *dat
         perror(path);
         exit(2);
     }
+}
+
+/* Loads and commits dir/name with the reader its extension names; on
+ * failure prints the error (and frees nothing: s is left as the loader
+ * left it). Returns the status. */
+static inline int test_load(const char *dir, const char *name, cdl_scene *s, cdl_scene_settings *set, cdl_error *err)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    cdl_scene_settings_init(set);
+    int rc = cdl_scene_init(s, path, err);
+    if (!rc)
+        rc = cdl_scene_load(s, path, set, err);
+    if (!rc)
+        rc = cdl_scene_commit(s, err);
+    if (rc) {
+        char buf[2048];
+        cdl_error_format(err, buf, sizeof buf);
+        printf("      load %s: %s\n", name, buf);
+    }
+    return rc;
 }
 
 static inline void die_on(int rc, const cdl_error *err)

@@ -27,6 +27,7 @@ FAST = {
     "bdpt": {},
     "rigi": {"light_paths": 64, "interleave": 2},
     "pm": {"photons": 5000, "gather": 2},
+    "sppm": {"photons": 5000},
     "vcm": {"vcm_mode": "full"},
 }
 
@@ -206,7 +207,7 @@ def test_diff_write_read(tmp_path):
 
 def test_discovery():
     names = candela.integrators()
-    assert set(names) >= {"path", "bdpt", "ir", "rigi", "pm", "gkde", "splat", "vcm"}
+    assert set(names) >= {"path", "bdpt", "ir", "rigi", "pm", "gkde", "splat", "sppm", "vcm"}
     pm = {o["name"]: o for o in candela.options("pm")}
     assert pm["photons"]["default"] == "200000" and "spp" in pm and "mode" not in pm
     splat = {o["name"]: o for o in candela.options("splat")}

@@ -46,6 +46,8 @@ static int add_aovs(cdl_renderer *r, cdl_error *err)
         return err ? err->code : CDL_ERR_USAGE;
     if ((aov & CDL_AOV_MERGE) && cdl_film_add_aov(&r->film, "merge", 3, err) < 0)
         return err ? err->code : CDL_ERR_USAGE;
+    if ((aov & CDL_AOV_MERGECOUNT) && cdl_film_add_aov(&r->film, "mergecount", 1, err) < 0)
+        return err ? err->code : CDL_ERR_USAGE;
     for (int k = 1; (aov & CDL_AOV_STRATA) && k <= CDL_STRATA; k++) {
         char nm[32];
         snprintf(nm, sizeof nm, "strata%d", k);

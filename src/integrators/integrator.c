@@ -14,35 +14,37 @@ extern const cdl_integrator_vtbl cdl_rigi_integrator;
 extern const cdl_integrator_vtbl cdl_pm_integrator;
 extern const cdl_integrator_vtbl cdl_gkde_integrator;
 extern const cdl_integrator_vtbl cdl_splat_integrator;
+extern const cdl_integrator_vtbl cdl_sppm_integrator;
 extern const cdl_integrator_vtbl cdl_vcm_integrator;
 
 static const cdl_integrator_vtbl *const all[] = {&cdl_path_integrator, &cdl_bdpt_integrator,
                                                  &cdl_ir_integrator, &cdl_rigi_integrator,
                                                  &cdl_pm_integrator, &cdl_gkde_integrator, &cdl_splat_integrator,
-                                                 &cdl_vcm_integrator, NULL};
+                                                 &cdl_sppm_integrator, &cdl_vcm_integrator, NULL};
 
 #define AT(f) CDL_PARAM_AT(cdl_options, f)
 
 static const cdl_param density_rows[] = {
     {"progressive", CDL_PARAM_BOOL, "on|off", "on",
-     "consistent: every bandwidth (pm's radii, gkde's h, splat's kernels) shrinks with the pass index i as r_i^2 = "
-     "r_0^2 prod (j + alpha) / (j + 1) (Knaus & Zwicker 2011), vcm's merge radius as r_1 i^((alpha - 1) / 2) "
-     "(SmallVCM's), so the bias falls with time; off: the fixed bandwidths of the reports (vcm: r_1)",
+     "consistent: every bandwidth shrinks with the passes, so the bias falls with time: pm's radii, gkde's h and "
+     "splat's kernels with the pass index i as r_i^2 = r_0^2 prod (j + alpha) / (j + 1) (Knaus & Zwicker 2011), "
+     "sppm's per-pixel radii by its photon counts, vcm's merge radius as r_1 i^((alpha - 1) / 2) (SmallVCM's); off: "
+     "the fixed bandwidths of the reports (vcm: r_1)",
      AT(progressive)},
     {"alpha", CDL_PARAM_FLOAT, "a", "2/3",
      "radius reduction: r^2 falls about as i^(alpha - 1); smaller shrinks faster with more noise", 0, 1,
      .note = "1 keeps the bandwidths fixed, 0 lets the noise grow", .flags = CDL_PARAM_OPEN_MIN | CDL_PARAM_OPEN_MAX,
      AT(alpha)},
 };
-const cdl_param_table cdl_density_table = CDL_PARAM_TABLE("Density estimation (pm, gkde, splat, vcm)", density_rows);
+const cdl_param_table cdl_density_table = CDL_PARAM_TABLE("Density estimation (pm, gkde, splat, sppm, vcm)", density_rows);
 
 static const cdl_param photon_rows[] = {
     {"photons", CDL_PARAM_INT, "N", "200000",
      "photons stored per pass: pm's global map (paths are traced until it holds N), splat's photon rays of all "
-     "budgets",
+     "budgets, sppm's photons",
      1, 5e8, AT(photons)},
 };
-const cdl_param_table cdl_photon_table = CDL_PARAM_TABLE("Photons (pm, splat)", photon_rows);
+const cdl_param_table cdl_photon_table = CDL_PARAM_TABLE("Photons (pm, splat, sppm)", photon_rows);
 
 static const double per_sample[] = {CDL_LIGHT_PATHS_PER_SAMPLE};
 static const cdl_param light_path_rows[] = {

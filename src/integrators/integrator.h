@@ -90,6 +90,13 @@ typedef struct cdl_splat_options {
                           * test out to c h (spatial/splatkd.h) */
 } cdl_splat_options;
 
+/* sppm: stochastic progressive photon mapping (Hachisuka & Jensen 2009) */
+typedef struct cdl_sppm_options {
+    float radius;     /* initial radius of every pixel's disc; <= 0: radius_px pixel footprints */
+    float radius_px;  /* that default, in pixel footprints at the pixel's first visible point */
+    int visibility;   /* leave out photons no free path joins to the visible point (a shadow ray each) */
+} cdl_sppm_options;
+
 /* vcm: vertex connection and merging (Georgiev et al. 2012) */
 typedef struct cdl_vcm_options {
     float radius;   /* merge radius of the first pass; <= 0: from the pixel footprint */
@@ -100,7 +107,8 @@ typedef struct cdl_vcm_options {
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX
 
 /* extra image layers (cdl_options.aov bits) */
-enum { CDL_AOV_PATHLENGTH = 1, CDL_AOV_STRATA = 2, CDL_AOV_BANDWIDTH = 4, CDL_AOV_RECORDS = 8, CDL_AOV_MERGE = 16 };
+enum { CDL_AOV_PATHLENGTH = 1, CDL_AOV_STRATA = 2, CDL_AOV_BANDWIDTH = 4, CDL_AOV_RECORDS = 8, CDL_AOV_MERGE = 16,
+       CDL_AOV_MERGECOUNT = 32 };
 
 typedef struct cdl_options {
     cdl_camera camera;
@@ -131,6 +139,7 @@ typedef struct cdl_options {
     cdl_pm_options pm;
     cdl_gkde_options gkde;
     cdl_splat_options splat;
+    cdl_sppm_options sppm;
     cdl_vcm_options vcm;
 } cdl_options;
 
@@ -142,7 +151,7 @@ float cdl_default_threshold(const cdl_scene *s, const cdl_options *opt);
 void cdl_options_default(cdl_options *o);
 
 /* Rows shared by several methods (each lists the tables it reads):
- * progressive and alpha (pm, gkde, splat, vcm), photons (pm, splat), light
+ * progressive and alpha (pm, gkde, splat, sppm, vcm), photons (pm, splat, sppm), light
  * paths, interleave and threshold (bdpt, ir, rigi), shadow_mode (ir,
  * rigi, gkde). */
 extern const cdl_param_table cdl_density_table, cdl_photon_table, cdl_light_path_table, cdl_shadow_table;

@@ -423,7 +423,7 @@ static uint64_t vcm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int
     cnt_spec.eye = 1.0f;
     cx_spec.counts = &cnt_spec;
     uint64_t bad = 0, found = 0, merged = 0, queries = 0;
-    int a_merge = cdl_film_find_aov(film, "merge");
+    int a_merge = cdl_film_find_aov(film, "merge"), a_count = cdl_film_find_aov(film, "mergecount");
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             uint32_t pix = (uint32_t)y * (uint32_t)film->width + (uint32_t)x;
@@ -445,8 +445,11 @@ static uint64_t vcm_tile(void *self, cdl_film *film, int x0, int y0, int x1, int
                 L = specular_emission(st, &cx_spec, &evs, ne);
             }
             cdl_vec3 Lm = cdl_v3(0.0f, 0.0f, 0.0f);
+            uint64_t merged0 = merged;
             if (merge)
                 Lm = merge_all(st, &cx, &evs, ne, part, rays, &found, &merged, &queries);
+            if (a_count >= 0)
+                film->aovs[a_count].sum[pix] += (double)(merged - merged0);
             L = cdl_add(L, Lm);
             bad += (uint64_t)cdl_film_add(film, x, y, fw == 1.0f ? L : cdl_scale(L, fw));
             if (a_merge >= 0 && cdl_is_finite3(L)) { /* the merges' part of this sample */
@@ -542,7 +545,7 @@ static void vcm_destroy(void *self)
     cdl_hashgrid_free(&st->grid);
 }
 
-static const double aov_bits[] = {CDL_AOV_MERGE};
+static const double aov_bits[] = {CDL_AOV_MERGE, CDL_AOV_MERGECOUNT};
 static const cdl_param rows[] = {
     {"radius", CDL_PARAM_FLOAT, "r", "", "merge radius of the first pass, r_1 (pass i: r_1 i^((alpha - 1) / 2)); "
      "default 1.5 times the median pixel footprint at the first hits (printed in the statistics)", 1e-9, 1e9,
@@ -555,8 +558,9 @@ static const cdl_param rows[] = {
     {"merge_visibility", CDL_PARAM_BOOL, "on|off", "on", "a merge counts only if a free segment joins the eye vertex "
      "to the light vertex (a shadow ray each, as pm's visibility): no light through thin walls; off: SmallVCM's "
      "merges", CDL_PARAM_AT(cdl_options, vcm.visibility)},
-    {"aov", CDL_PARAM_CHOICE, "NAME", "", "extra EXR layer: merge (the merges' MIS-weighted part of the image; the "
-     "rest is the connections')", .choices = "merge", .values = aov_bits, .flags = CDL_PARAM_BITS,
+    {"aov", CDL_PARAM_CHOICE, "NAME", "", "extra EXR layers, repeatable: merge (the merges' MIS-weighted part of the "
+     "image; the rest is the connections') or mergecount (light vertices merged per pixel sample)",
+     .choices = "merge|mergecount", .values = aov_bits, .flags = CDL_PARAM_BITS,
      CDL_PARAM_AT(cdl_options, aov)},
 };
 static const cdl_param_table table =

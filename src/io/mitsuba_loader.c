@@ -276,7 +276,7 @@ static int integrator(cdl_mts_ctx *c, cdl_xml_node *n)
         return rc;
     static const char *const map[][2] = {{"path", "path"},         {"volpath", "path"}, {"volpath_simple", "path"},
                                          {"direct", "path"},       {"bdpt", "bdpt"},    {"photonmapper", "pm"},
-                                         {"sppm", "pm"},           {"ppm", "pm"},       {"ptracer", "path"}};
+                                         {"sppm", "sppm"},         {"ppm", "pm"},       {"ptracer", "path"}};
     const char *ours = NULL;
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (!strcmp(type, map[i][0]))
@@ -310,7 +310,8 @@ static int integrator(cdl_mts_ctx *c, cdl_xml_node *n)
                                            {"photon_count", "photons"},   {"photonCount", "photons"},
                                            {"lookup_size", "knn"},        {"lookupSize", "knn"},
                                            {"global_lookup_radius", "max_radius"},
-                                           {"globalLookupRadius", "max_radius"}};
+                                           {"globalLookupRadius", "max_radius"},
+                                           {"initial_radius", "radius"},  {"initialRadius", "radius"}};
     for (int i = 0; i < n->nkids; i++) {
         cdl_xml_node *k = &n->kids[i];
         const char *name = cdl_xml_attr_get(k, "name"), *value = cdl_xml_attr_get(k, "value");

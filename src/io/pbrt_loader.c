@@ -367,6 +367,8 @@ static int integrator(cdl_pbrt_ctx *c, const char *type)
         if (p->used)
             continue;
         p->used = 1;
+        /* pbrt's sppm names its photons per pass so */
+        const char *name = !strcmp(p->name, "photonsperiteration") ? "photons" : p->name;
         char v[96] = "";
         for (size_t k = 0; k < p->n; k++) {
             size_t len = strlen(v);
@@ -377,7 +379,7 @@ static int integrator(cdl_pbrt_ctx *c, const char *type)
             else
                 snprintf(v + len, sizeof v - len, "%s%.17g", k ? "," : "", cdl_pbrt_nums(&c->ps, p)[k]);
         }
-        cdl_scene_settings_param(set, p->name, v, c->ps.file, p->line);
+        cdl_scene_settings_param(set, name, v, c->ps.file, p->line);
     }
     return 0;
 }

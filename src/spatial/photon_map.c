@@ -193,6 +193,43 @@ cdl_vec3 cdl_pmap_irradiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl
     return irradiance(m, q, x, nrm, nrm, &r2);
 }
 
+typedef struct flux_ctx {
+    const cdl_photon_map *m;
+    const cdl_pm_query *q;
+    const cdl_bsdf *b;
+    cdl_vec3 wo, nx, phi;
+    vis_origin vo;
+    uint32_t n;
+} flux_ctx;
+
+static void flux_visit(void *ctx, uint32_t i, float d2)
+{
+    (void)d2;
+    flux_ctx *c = ctx;
+    const cdl_photon *ph = &c->m->ph[i];
+    /* a photon from the far side of a thin wall arrived against nx */
+    if (left_out(c->q, ph) || cdl_dot(cdl_photon_n(ph), c->nx) <= 0.0f)
+        return;
+    c->n++;
+    cdl_vec3 f = cdl_bsdf_eval(c->b, c->wo, cdl_photon_wi(ph), 0);
+    if (cdl_is_black(f) || !visible(c->q, &c->vo, ph))
+        return;
+    c->phi = cdl_add(c->phi, cdl_mul(f, cdl_v3(ph->power[0], ph->power[1], ph->power[2])));
+}
+
+uint32_t cdl_pmap_flux(const cdl_photon_map *m, const cdl_pm_query *q, float r2, cdl_vec3 x, cdl_vec3 wo,
+                       const cdl_bsdf *b, cdl_vec3 *phi)
+{
+    *phi = cdl_v3(0.0f, 0.0f, 0.0f);
+    if (!m->n || !m->built || !(r2 > 0.0f))
+        return 0;
+    cdl_vec3 nx = cdl_dot(b->ng, wo) < 0.0f ? cdl_neg(b->ng) : b->ng;
+    flux_ctx c = {m, q, b, wo, nx, cdl_v3(0.0f, 0.0f, 0.0f), {x, nx, wo, x, CDL_VIS_LIFT * sqrtf(r2), 0}, 0};
+    cdl_kd_ball(&m->kd, x, r2, flux_visit, &c);
+    *phi = c.phi;
+    return c.n;
+}
+
 /* 1 in `every` photons carries an irradiance point, picked by a hash of its
  * position: a thinning that does not depend on where the other photons lie. */
 static int carries_point(const cdl_photon *ph, uint32_t every)

@@ -122,6 +122,14 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
                            const cdl_bsdf *b);
 
 
+/* Stochastic progressive photon mapping's statistics at a visible point
+ * (Hachisuka & Jensen 2009): over the photons within sqrt(r2) of x that q
+ * does not leave out (skip, max_depth, vis; k, kernel and shrink unused)
+ * and that arrived on the side wo is on, the sum of f(wo, wi_p) flux_p
+ * into *phi (not divided by the disc's area); returns their number. */
+uint32_t cdl_pmap_flux(const cdl_photon_map *m, const cdl_pm_query *q, float r2, cdl_vec3 x, cdl_vec3 wo,
+                       const cdl_bsdf *b, cdl_vec3 *phi);
+
 /* Precomputed irradiance (Christensen 1999): the irradiance from both
  * maps at 1 in m global photons, so that a final-gathering ray that
  * lands on a Lambertian surface costs one small lookup instead of a
