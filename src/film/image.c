@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <math.h>
 #include <png.h>
+#include <stb_image.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,6 +40,17 @@ void cdl_image_free(cdl_image *img)
     free(img->rgb);
     img->rgb = NULL;
     img->width = img->height = 0;
+}
+
+int cdl_image_check_stb(const char *path, cdl_error *err)
+{
+    int w, h, n;
+    if (!stbi_info(path, &w, &h, &n))
+        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "cannot read image: %s", stbi_failure_reason());
+    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > CDL_MAX_PIXELS)
+        return cdl_error_set(err, CDL_ERR_INPUT, path, 0, "image size %dx%d out of range (at most 2^%d pixels)",
+                             w, h, CDL_MAX_PIXELS == (1ull << 28) ? 28 : 22);
+    return 0;
 }
 
 int cdl_image_has_ext(const char *path, const char *ext)

@@ -19,10 +19,18 @@ typedef struct cdl_kv {
 
 /* The largest image read or made: 2^28 pixels (16384 x 16384, 3 GiB of
  * floats), so that a hostile file header cannot ask for more. */
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+#define CDL_MAX_PIXELS (1ull << 22) /* 20 s per input under ASan */
+#else
 #define CDL_MAX_PIXELS (1ull << 28)
+#endif
 
 /* Zero-filled image; w, h > 0 and w h <= CDL_MAX_PIXELS. */
 int cdl_image_alloc(cdl_image *img, int w, int h, cdl_error *err);
+/* Checks an 8-bit or Radiance image's header (read by stb_image) before it
+ * is decoded: the size must be within CDL_MAX_PIXELS, since a 30-byte TGA
+ * can declare 750 million RLE pixels. */
+int cdl_image_check_stb(const char *path, cdl_error *err);
 /* Frees the pixels and zeroes the struct; safe on a zeroed image. */
 void cdl_image_free(cdl_image *img);
 

@@ -202,6 +202,9 @@ int cdl_envmap_load(cdl_envmap *m, const char *path, cdl_vec3 scale, const cdl_v
     cdl_image img = {0};
     int rc = 0;
     if (cdl_image_has_ext(path, ".hdr")) {
+        rc = cdl_image_check_stb(path, err);
+        if (rc)
+            return rc;
         int w, h, n;
         float *px = stbi_loadf(path, &w, &h, &n, 3);
         if (!px)

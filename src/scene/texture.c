@@ -43,6 +43,9 @@ int cdl_texture_load_image(cdl_texture *t, const char *path, int raw, cdl_error 
         t->rgb = img.rgb;
         return 0;
     }
+    int rc = cdl_image_check_stb(path, err);
+    if (rc)
+        return rc;
     int w, h, n;
     unsigned char *px = stbi_load(path, &w, &h, &n, 3);
     if (!px)
