@@ -5,7 +5,11 @@
 #  - vcm_mode merge (merging alone, a progressive photon mapper over the same
 #    light paths) converges to the reference: from N to 4N passes the median
 #    of the 16x16 block ratios moves towards 1 (or is within 1 % already) and
-#    the relative MSE falls.
+#    the relative MSE falls;
+#  - merging with 4 light paths per pixel (merge_paths 4: 3 merged with
+#    only) agrees with the reference as closely (block median within 1 %,
+#    or no further off than one path's) at lower relative MSE: the count
+#    in eta and the merges' normalization match.
 # (Full vcm against the reference: reference.sh.)
 # usage: vcm_modes.sh CANDELA IMAGE_MAXREL REF.exr N -- SCENE render args...
 set -u
@@ -26,8 +30,8 @@ render() { # out args...
 # connect vs bdpt: small and quick, every strategy incl. light tracing
 render "$tmp/bdpt.exr" "$@" -i bdpt --res 64x64 --spp 4 --seed 3
 render "$tmp/vc.exr" "$@" -i vcm --vcm-mode connect --res 64x64 --spp 4 --seed 3
-d=$("$maxrel" "$tmp/vc.exr" "$tmp/bdpt.exr")
-if awk -v d="$d" 'BEGIN {exit !(d <= 1e-6)}'; then ok "vcm connect = bdpt: max relative difference $d"
+d=$("$maxrel" "$tmp/vc.exr" "$tmp/bdpt.exr") || bad "image_maxrel exited $?"
+if [[ $d =~ ^[0-9.eE+-]+$ ]] && awk -v d="$d" 'BEGIN {exit !(d + 0 <= 1e-6)}'; then ok "vcm connect = bdpt: max relative difference $d"
 else bad "vcm connect vs bdpt: max relative difference $d (> 1e-6)"; fi
 
 # merge alone: bias shrinking with the passes (one render, snapshots at N and 4N
@@ -43,5 +47,15 @@ else
 fi
 if awk -v a="$e1" -v b="$e4" 'BEGIN {exit !(b < a)}'; then ok "vcm merge: relMSE $e1 -> $e4"
 else bad "vcm merge: relMSE $e1 -> $e4 (did not fall)"; fi
+
+render "$tmp/k4.exr" "$@" -i vcm --vcm-mode merge --merge-paths 4 --spp "$n" --seed 1
+bk=$(key "$tmp/k4.exr" block_median_ratio) ek=$(key "$tmp/k4.exr" relmse)
+if awk -v a="$b1" -v b="$bk" 'BEGIN {da = a > 1 ? a - 1 : 1 - a; db = b > 1 ? b - 1 : 1 - b; exit !(db <= da + 0.002 || db < 0.01)}'; then
+  ok "vcm merge, 4 light paths per pixel: block median $bk at $n passes (one path: $b1)"
+else
+  bad "vcm merge, 4 light paths per pixel: block median $bk at $n passes (one path: $b1)"
+fi
+if awk -v a="$e1" -v b="$ek" 'BEGIN {exit !(b < 0.8 * a)}'; then ok "vcm merge, 4 light paths per pixel: relMSE $ek (one path: $e1)"
+else bad "vcm merge, 4 light paths per pixel: relMSE $ek, not below 0.8 of one path's $e1"; fi
 
 exit $fail

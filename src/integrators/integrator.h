@@ -102,6 +102,7 @@ typedef struct cdl_vcm_options {
     float radius;   /* merge radius of the first pass; <= 0: from the pixel footprint */
     int mode;       /* full, connect (bdpt) or merge (merging alone) */
     int visibility; /* merges test visibility with a shadow ray */
+    float merge_paths; /* light paths per pass merged with, in multiples of the pixels (>= 1) */
 } cdl_vcm_options;
 
 #define CDL_LIGHT_PATHS_PER_SAMPLE UINT32_MAX

@@ -88,6 +88,11 @@ typedef struct vcm_lv {
 } vcm_lv;
 #define LV_FLOATS (sizeof(vcm_lv) / sizeof(float))
 
+typedef struct lv_buf {
+    vcm_lv *v;
+    uint32_t n, cap;
+} lv_buf;
+
 typedef struct vcm_state {
     const cdl_scene *scene;
     cdl_options opt;
@@ -95,10 +100,12 @@ typedef struct vcm_state {
     int mode;
     float r1;               /* first pass's radius */
     float r, eta, norm;     /* this pass's radius, pi r^2 N, 1 / (pi r^2 N) */
-    uint32_t npaths, nchunks;
+    uint32_t npaths, nchunks; /* light paths connected to (one per pixel) and their chunks */
+    uint32_t nvm, nvm_chunks; /* light paths merged with (the npaths first) and all chunks */
     cdl_vertex_store *chunks; /* light paths: path i in chunks[i / CHUNK] from start[i], len[i] vertices */
-    uint32_t *start, *len, *nmerge;
-    vcm_lv *lv, *lv_tmp;
+    uint32_t *start, *len;
+    lv_buf *bufs;             /* each chunk's mergeable vertices, in path order */
+    vcm_lv *lv;               /* all of them, in bucket order */
     uint32_t nlv, lv_cap;
     cdl_hashgrid grid;
     cdl_splats *tile_splats;
@@ -167,14 +174,21 @@ static int vcm_prepare(void *self, const cdl_scene *scene, const cdl_options *op
         return cdl_error_set(err, CDL_ERR_USAGE, "res", 0, "too many pixels for vcm's light paths");
     st->npaths = (uint32_t)npix;
     st->nchunks = (st->npaths + CHUNK - 1) / CHUNK;
+    double nvm = st->mode == VCM_CONNECT ? (double)npix : ceil((double)opt->vcm.merge_paths * (double)npix);
+    if (!(nvm >= (double)npix) || nvm > (double)(UINT32_MAX / 4))
+        return cdl_error_set(err, CDL_ERR_USAGE, "merge_paths", 0,
+                             "%g light paths per pixel for merging make %.0f a pass: at least one per pixel, at "
+                             "most %u in all", (double)opt->vcm.merge_paths, nvm, UINT32_MAX / 4);
+    st->nvm = (uint32_t)nvm;
+    st->nvm_chunks = st->nchunks + (st->nvm - st->npaths + CHUNK - 1) / CHUNK;
     st->chunks = calloc(st->nchunks, sizeof *st->chunks);
     st->start = calloc(st->npaths, sizeof(uint32_t));
     st->len = calloc(st->npaths, sizeof(uint32_t));
-    st->nmerge = calloc(st->nchunks + 1, sizeof(uint32_t));
+    st->bufs = calloc(st->nvm_chunks, sizeof *st->bufs);
     int tx = (opt->camera.width + 15) / 16, ty = (opt->camera.height + 15) / 16;
     st->ntiles = tx * ty;
     st->tile_splats = calloc((size_t)st->ntiles, sizeof(cdl_splats));
-    if (!st->chunks || !st->start || !st->len || !st->nmerge || !st->tile_splats)
+    if (!st->chunks || !st->start || !st->len || !st->bufs || !st->tile_splats)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "vcm", 0, "out of memory");
     return 0;
 }
@@ -191,10 +205,12 @@ static int mergeable(const vcm_state *st, const cdl_vertex_store *vs, uint32_t i
 
 static size_t state_bytes(const vcm_state *st)
 {
-    size_t b = (size_t)st->lv_cap * 2 * sizeof(vcm_lv) + cdl_hashgrid_bytes(&st->grid) +
+    size_t b = (size_t)st->lv_cap * sizeof(vcm_lv) + cdl_hashgrid_bytes(&st->grid) +
                (size_t)st->npaths * 2 * sizeof(uint32_t);
     for (uint32_t c = 0; c < st->nchunks; c++)
         b += cdl_vs_bytes(&st->chunks[c]);
+    for (uint32_t c = 0; c < st->nvm_chunks; c++)
+        b += (size_t)st->bufs[c].cap * sizeof(vcm_lv);
     return b;
 }
 
@@ -209,7 +225,37 @@ static cdl_mis_counts counts(const vcm_state *st)
     return (cdl_mis_counts){1.0f, 1.0f, 1.0f, 0.0f, 0.0f, st->mode == VCM_FULL ? st->eta : 0.0f};
 }
 
-/* The pass's light paths, their mergeable vertices and the hash grid over them. */
+/* Appends one path's mergeable vertices to its chunk's buffer. */
+static int keep_mergeable(const vcm_state *st, const cdl_connect_ctx *cx, const cdl_vertex_store *vs, uint32_t l0,
+                          uint32_t nl, float *part, uint32_t room, lv_buf *b)
+{
+    float *a1 = part, *a2 = part + room, *gl = part + 2 * room;
+    cdl_merge_partials_light(cx, vs, l0, nl, a1, a2, gl);
+    for (uint32_t a = 1; a < nl; a++) {
+        uint32_t j = l0 + a;
+        if (!mergeable(st, vs, j))
+            continue;
+        if (b->n == b->cap) {
+            uint32_t cap = b->cap ? 2 * b->cap : 4 * CHUNK;
+            vcm_lv *v = realloc(b->v, (size_t)cap * sizeof *v);
+            if (!v)
+                return 1;
+            b->v = v;
+            b->cap = cap;
+        }
+        b->v[b->n++] = (vcm_lv){{vs->p[j].x, vs->p[j].y, vs->p[j].z},
+                                {vs->wi[j].x, vs->wi[j].y, vs->wi[j].z},
+                                {vs->beta[j].x, vs->beta[j].y, vs->beta[j].z},
+                                a1[a], a2[a], gl[a], vs->depth[j]};
+    }
+    return 0;
+}
+
+/* The pass's light paths, their mergeable vertices and the hash grid over
+ * them. Paths 0 .. npaths - 1 (one per pixel) are kept whole for the
+ * connections; the rest (merge_paths) only leave their mergeable vertices.
+ * Path i draws from sample stream npaths + i, or 2 npaths + i past npaths
+ * (2 npaths + pixel is a pixel's resampling stream). */
 static int trace_lights(vcm_state *st, uint32_t pass, uint64_t *rays, cdl_error *err)
 {
     double t0 = cdl_time_now();
@@ -217,26 +263,48 @@ static int trace_lights(vcm_state *st, uint32_t pass, uint64_t *rays, cdl_error 
     uint64_t total = 0;
     int fail = 0;
     int merging = st->mode != VCM_CONNECT;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : total, fail)
-    for (uint32_t c = 0; c < st->nchunks; c++) {
-        cdl_vertex_store *vs = &st->chunks[c];
-        cdl_vs_clear(vs);
-        uint32_t end = (c + 1) * CHUNK < st->npaths ? (c + 1) * CHUNK : st->npaths, nm = 0;
-        for (uint32_t i = c * CHUNK; i < end; i++) {
-            if (cdl_vs_reserve(vs, vs->n + room, NULL)) {
-                fail++;
-                break;
+    cdl_mis_counts cnt = counts(st);
+    cdl_connect_ctx cx = {st->scene, &st->opt.camera, st->opt.mis, 0.0f, &cnt, 1};
+    uint32_t nchunks = merging ? st->nvm_chunks : st->nchunks;
+#pragma omp parallel reduction(+ : total, fail)
+    {
+        float *part = malloc(sizeof(float) * 3 * room);
+        cdl_vertex_store scratch;
+        cdl_vs_init(&scratch);
+        if (!part)
+            fail++;
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t c = 0; c < nchunks; c++) {
+            int keep = c < st->nchunks;
+            cdl_vertex_store *vs = keep ? &st->chunks[c] : &scratch;
+            uint32_t i0 = keep ? c * CHUNK : st->npaths + (c - st->nchunks) * CHUNK;
+            uint32_t lim = keep ? st->npaths : st->nvm, end = i0 + CHUNK < lim ? i0 + CHUNK : lim;
+            cdl_vs_clear(vs);
+            st->bufs[c].n = 0;
+            for (uint32_t i = i0; part && !fail && i < end; i++) {
+                if (!keep)
+                    cdl_vs_clear(vs);
+                if (cdl_vs_reserve(vs, vs->n + room, NULL)) {
+                    fail++;
+                    break;
+                }
+                cdl_sampler smp;
+                cdl_sampler_start(&smp, st->opt.sampler, st->opt.seed,
+                                  (uint64_t)i + (keep ? 1 : 2) * (uint64_t)st->npaths, pass);
+                uint64_t r = 0;
+                uint32_t l0 = vs->n;
+                uint32_t nl = cdl_trace_light_subpath(st->scene, &st->walk, &smp, vs, &r);
+                total += r;
+                if (keep) {
+                    st->start[i] = l0;
+                    st->len[i] = nl;
+                }
+                if (merging && keep_mergeable(st, &cx, vs, l0, nl, part, room, &st->bufs[c]))
+                    fail++;
             }
-            cdl_sampler smp;
-            cdl_sampler_start(&smp, st->opt.sampler, st->opt.seed, (uint64_t)i + st->npaths, pass);
-            uint64_t r = 0;
-            st->start[i] = vs->n;
-            st->len[i] = cdl_trace_light_subpath(st->scene, &st->walk, &smp, vs, &r);
-            total += r;
-            for (uint32_t j = st->start[i]; merging && j < vs->n; j++)
-                nm += (uint32_t)mergeable(st, vs, j);
         }
-        st->nmerge[c] = nm;
+        cdl_vs_free(&scratch);
+        free(part);
     }
     *rays += total;
     if (fail)
@@ -245,61 +313,54 @@ static int trace_lights(vcm_state *st, uint32_t pass, uint64_t *rays, cdl_error 
     if (!merging)
         return 0;
     t0 = cdl_time_now();
-    /* offsets per chunk, then each chunk copies its vertices in path order */
-    uint32_t n = 0;
-    for (uint32_t c = 0; c < st->nchunks; c++) {
-        uint32_t k = st->nmerge[c];
-        st->nmerge[c] = n;
-        n += k;
-    }
+    uint64_t n = 0;
+    for (uint32_t c = 0; c < nchunks; c++)
+        n += st->bufs[c].n;
+    if (n > UINT32_MAX / 2)
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "vcm", 0, "%llu light vertices to merge with: too many",
+                             (unsigned long long)n);
     if (n > st->lv_cap) {
         free(st->lv);
-        free(st->lv_tmp);
-        st->lv_cap = n + n / 4;
+        st->lv_cap = (uint32_t)(n + n / 4);
         st->lv = malloc((size_t)st->lv_cap * sizeof(vcm_lv));
-        st->lv_tmp = malloc((size_t)st->lv_cap * sizeof(vcm_lv));
-        if (!st->lv || !st->lv_tmp) {
+        if (!st->lv) {
             st->lv_cap = 0;
-            return cdl_error_set(err, CDL_ERR_SYSTEM, "vcm", 0, "out of memory for %u light vertices", n);
+            return cdl_error_set(err, CDL_ERR_SYSTEM, "vcm", 0, "out of memory for %llu light vertices",
+                                 (unsigned long long)n);
         }
     }
-    cdl_mis_counts cnt = counts(st);
-    cdl_connect_ctx cx = {st->scene, &st->opt.camera, st->opt.mis, 0.0f, &cnt, 1};
-#pragma omp parallel
-    {
-        float *part = malloc(sizeof(float) * 3 * room);
-#pragma omp for schedule(dynamic, 1)
-        for (uint32_t c = 0; c < st->nchunks; c++) {
-            const cdl_vertex_store *vs = &st->chunks[c];
-            vcm_lv *o = st->lv_tmp + st->nmerge[c];
-            uint32_t end = (c + 1) * CHUNK < st->npaths ? (c + 1) * CHUNK : st->npaths;
-            for (uint32_t i = c * CHUNK; part && i < end; i++) {
-                uint32_t l0 = st->start[i], nl = st->len[i];
-                float *a1 = part, *a2 = part + room, *gl = part + 2 * room;
-                cdl_merge_partials_light(&cx, vs, l0, nl, a1, a2, gl);
-                for (uint32_t a = 1; a < nl; a++) {
-                    uint32_t j = l0 + a;
-                    if (!mergeable(st, vs, j))
-                        continue;
-                    *o++ = (vcm_lv){{vs->p[j].x, vs->p[j].y, vs->p[j].z},
-                                    {vs->wi[j].x, vs->wi[j].y, vs->wi[j].z},
-                                    {vs->beta[j].x, vs->beta[j].y, vs->beta[j].z},
-                                    a1[a], a2[a], gl[a], vs->depth[j]};
-                }
-            }
-            if (!part)
-                fail = 1;
+    /* gather in chunk order (fixed by the paths, not the threads) */
+    for (uint32_t c = 0, o = 0; c < nchunks; c++) {
+        if (st->bufs[c].n)
+            memcpy(st->lv + o, st->bufs[c].v, st->bufs[c].n * sizeof(vcm_lv));
+        o += st->bufs[c].n;
+        if (st->bufs[c].cap > 64 * CHUNK) { /* a deep chunk's buffer is not kept between passes */
+            free(st->bufs[c].v);
+            st->bufs[c] = (lv_buf){0};
         }
-        free(part);
     }
-    if (fail)
-        return cdl_error_set(err, CDL_ERR_SYSTEM, "vcm", 0, "out of memory");
-    st->nlv = n;
-    if (cdl_hashgrid_build(&st->grid, (const float *)st->lv_tmp, (uint32_t)LV_FLOATS, n, st->r, err))
+    st->nlv = (uint32_t)n;
+    if (cdl_hashgrid_build(&st->grid, (const float *)st->lv, (uint32_t)LV_FLOATS, st->nlv, st->r, err))
         return err->code;
-    /* bucket order: a query's points lie together in memory */
-    for (uint32_t i = 0; i < n; i++)
-        st->lv[i] = st->lv_tmp[st->grid.order[i]];
+    /* bucket order, in place by following the permutation's cycles: a
+     * query's points lie together in memory */
+    uint32_t *ord = st->grid.order;
+    for (uint32_t i = 0; i < st->nlv; i++) {
+        if (ord[i] == i)
+            continue;
+        vcm_lv tmp = st->lv[i];
+        uint32_t j = i;
+        for (;;) {
+            uint32_t k = ord[j];
+            ord[j] = j;
+            if (k == i) {
+                st->lv[j] = tmp;
+                break;
+            }
+            st->lv[j] = st->lv[k];
+            j = k;
+        }
+    }
     cdl_hashgrid_make_identity(&st->grid, (const float *)st->lv);
     st->stored += n;
     st->nlv_last = n;
@@ -478,7 +539,7 @@ static int vcm_render_pass(void *self, cdl_film *film, uint32_t pass, cdl_error 
     st->r = st->r1;
     if (st->opt.progressive)
         st->r *= powf((float)pass + 1.0f, 0.5f * (st->opt.alpha - 1.0f));
-    st->eta = (float)CDL_PI * st->r * st->r * (float)st->npaths;
+    st->eta = (float)CDL_PI * st->r * st->r * (float)st->nvm;
     st->norm = 1.0f / st->eta;
     int rc = trace_lights(st, pass, &film->rays, err);
     if (rc)
@@ -508,10 +569,10 @@ static void vcm_report(const void *self, cdl_stats *out)
     static const char *const modes[] = {"full", "connect", "merge"};
     double mib = 1.0 / (1024.0 * 1024.0), P = st->passes ? (double)st->passes : 1.0;
     double q = st->queries ? (double)st->queries : 1.0;
-    cdl_stats_printf(out, "vcm: mode %s, %u light paths per pass, merge radius r_1 %.4g (%s), r %.4g at pass %u; "
+    cdl_stats_printf(out, "vcm: mode %s, %u light paths per pass (%u merged with), merge radius r_1 %.4g (%s), r %.4g at pass %u; "
                      "%.0f light vertices stored per pass (%llu in the last); per merge query %.2f found, %.2f "
                      "merged; memory %.2f MiB (peak: light paths, %zu B per light vertex + hash grid)\n",
-                     modes[st->mode], st->npaths, st->r1, st->opt.vcm.radius > 0.0f ? "given" : "1.5 pixel footprints",
+                     modes[st->mode], st->npaths, st->mode == VCM_CONNECT ? 0 : st->nvm, st->r1, st->opt.vcm.radius > 0.0f ? "given" : "1.5 pixel footprints",
                      st->r, st->passes, (double)st->stored / P, (unsigned long long)st->nlv_last,
                      (double)st->found / q, (double)st->merged / q, (double)st->peak_bytes * mib, sizeof(vcm_lv));
     cdl_stats_printf(out, "vcm: time over %u passes: light paths %.2f s, hash grid %.2f s, eye paths %.2f s\n",
@@ -538,9 +599,11 @@ static void vcm_destroy(void *self)
     free(st->chunks);
     free(st->start);
     free(st->len);
-    free(st->nmerge);
+    if (st->bufs)
+        for (uint32_t c = 0; c < st->nvm_chunks; c++)
+            free(st->bufs[c].v);
+    free(st->bufs);
     free(st->lv);
-    free(st->lv_tmp);
     free(st->tile_splats);
     cdl_hashgrid_free(&st->grid);
 }
@@ -558,6 +621,9 @@ static const cdl_param rows[] = {
     {"merge_visibility", CDL_PARAM_BOOL, "on|off", "on", "a merge counts only if a free segment joins the eye vertex "
      "to the light vertex (a shadow ray each, as pm's visibility): no light through thin walls; off: SmallVCM's "
      "merges", CDL_PARAM_AT(cdl_options, vcm.visibility)},
+    {"merge_paths", CDL_PARAM_FLOAT, "k", "1", "light paths traced per pass for merging, in multiples of the pixels: "
+     "one per pixel is also connected to (SmallVCM's count), the others are only merged with", 1, 1024,
+     CDL_PARAM_AT(cdl_options, vcm.merge_paths)},
     {"aov", CDL_PARAM_CHOICE, "NAME", "", "extra EXR layers, repeatable: merge (the merges' MIS-weighted part of the "
      "image; the rest is the connections') or mergecount (light vertices merged per pixel sample)",
      .choices = "merge|mergecount", .values = aov_bits, .flags = CDL_PARAM_BITS,
