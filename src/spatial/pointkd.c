@@ -7,25 +7,34 @@
 
 static float coord(const cdl_kdtree *t, uint32_t i, int a) { return t->pts[(size_t)i * t->stride + (size_t)a]; }
 
+/* The build sorts compact copies of the points (position and index, 16
+ * bytes) rather than indices into the caller's records, which may be wide:
+ * every pass over a subtree then reads contiguous memory. The comparisons
+ * and swaps are the same, so is the tree. */
+typedef struct kd_rec {
+    float p[3];
+    uint32_t i;
+} kd_rec;
+
 /* Quickselect with a three-way partition (robust to equal coordinates):
- * afterwards idx[k] holds the k-th smallest coordinate of idx[lo..hi),
- * with nothing larger before it and nothing smaller after it. */
-static void select_kth(const cdl_kdtree *t, uint32_t *idx, uint32_t lo, uint32_t hi, uint32_t k, int a)
+ * afterwards r[k] holds the k-th smallest coordinate of r[lo..hi), with
+ * nothing larger before it and nothing smaller after it. */
+static void select_kth(kd_rec *r, uint32_t lo, uint32_t hi, uint32_t k, int a)
 {
     while (hi - lo > 1) {
         uint32_t mid = lo + (hi - lo) / 2;
-        float x = coord(t, idx[lo], a), y = coord(t, idx[mid], a), z = coord(t, idx[hi - 1], a);
+        float x = r[lo].p[a], y = r[mid].p[a], z = r[hi - 1].p[a];
         float pivot = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
         uint32_t lt = lo, i = lo, gt = hi;
         while (i < gt) {
-            float c = coord(t, idx[i], a);
-            uint32_t tmp = idx[i];
+            float c = r[i].p[a];
+            kd_rec tmp = r[i];
             if (c < pivot) {
-                idx[i++] = idx[lt];
-                idx[lt++] = tmp;
+                r[i++] = r[lt];
+                r[lt++] = tmp;
             } else if (c > pivot) {
-                idx[i] = idx[--gt];
-                idx[gt] = tmp;
+                r[i] = r[--gt];
+                r[gt] = tmp;
             } else {
                 i++;
             }
@@ -42,13 +51,13 @@ static void select_kth(const cdl_kdtree *t, uint32_t *idx, uint32_t lo, uint32_t
 #define TASK_MIN 32768 /* subtrees this big are built as tasks of their own */
 
 /* tasks: inside a parallel region whose tasks may take subtrees */
-static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi, int tasks)
+static void build(cdl_kdtree *t, kd_rec *r, uint32_t lo, uint32_t hi, int tasks)
 {
     while (hi - lo > 1) {
         float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (uint32_t i = lo; i < hi; i++)
             for (int a = 0; a < 3; a++) {
-                float c = coord(t, t->idx[i], a);
+                float c = r[i].p[a];
                 mn[a] = c < mn[a] ? c : mn[a];
                 mx[a] = c > mx[a] ? c : mx[a];
             }
@@ -57,13 +66,13 @@ static void build(cdl_kdtree *t, uint32_t lo, uint32_t hi, int tasks)
             if (mx[b] - mn[b] > mx[a] - mn[a])
                 a = b;
         uint32_t mid = lo + (hi - lo) / 2;
-        select_kth(t, t->idx, lo, hi, mid, a);
+        select_kth(r, lo, hi, mid, a);
         t->axis[mid] = (uint8_t)a;
         if (tasks && mid - lo >= TASK_MIN) {
 #pragma omp task firstprivate(lo, mid)
-            build(t, lo, mid, 1);
+            build(t, r, lo, mid, 1);
         } else {
-            build(t, lo, mid, 0); /* recursion depth is log2(n) */
+            build(t, r, lo, mid, 0); /* recursion depth is log2(n) */
         }
         lo = mid + 1;
     }
@@ -82,21 +91,28 @@ int cdl_kd_build(cdl_kdtree *t, const float *pts, uint32_t stride, uint32_t n, c
                 return cdl_error_set(err, CDL_ERR_INPUT, "", 0, "kd-tree: point %u is not finite", i);
     t->idx = malloc(sizeof(uint32_t) * (n ? n : 1));
     t->axis = malloc(n ? n : 1);
-    if (!t->idx || !t->axis) {
+    kd_rec *r = malloc(sizeof *r * (n ? n : 1));
+    if (!t->idx || !t->axis || !r) {
+        free(r);
         cdl_kd_free(t);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for a kd-tree of %u points", n);
     }
-    for (uint32_t i = 0; i < n; i++)
-        t->idx[i] = i;
+    for (uint32_t i = 0; i < n; i++) {
+        const float *q = pts + (size_t)i * t->stride;
+        r[i] = (kd_rec){{q[0], q[1], q[2]}, i};
+    }
     t->n = n;
     if (n >= 2 * TASK_MIN && !omp_in_parallel()) {
         /* the subtrees are disjoint: the same tree whatever the threads */
 #pragma omp parallel
 #pragma omp single
-        build(t, 0, n, 1);
+        build(t, r, 0, n, 1);
     } else {
-        build(t, 0, n, 0);
+        build(t, r, 0, n, 0);
     }
+    for (uint32_t i = 0; i < n; i++)
+        t->idx[i] = r[i].i;
+    free(r);
     return 0;
 }
 
