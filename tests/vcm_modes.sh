@@ -40,22 +40,21 @@ render "$tmp/m1.exr" "$@" -i vcm --vcm-mode merge --spp "$n" --seed 1
 render "$tmp/m4.exr" "$@" -i vcm --vcm-mode merge --spp $((4 * n)) --seed 1
 b1=$(key "$tmp/m1.exr" block_median_ratio) b4=$(key "$tmp/m4.exr" block_median_ratio)
 e1=$(key "$tmp/m1.exr" relmse) e4=$(key "$tmp/m4.exr" relmse)
-if awk -v a="$b1" -v b="$b4" 'BEGIN {da = a > 1 ? a - 1 : 1 - a; db = b > 1 ? b - 1 : 1 - b; exit !(db < da || db < 0.01)}'; then
-  ok "vcm merge: block median $b1 at $n passes, $b4 at $((4 * n)) (towards 1, or within 1 %)"
-else
-  bad "vcm merge: block median $b1 at $n passes, $b4 at $((4 * n)) (moved away from 1)"
-fi
-if awk -v a="$e1" -v b="$e4" 'BEGIN {exit !(b < a)}'; then ok "vcm merge: relMSE $e1 -> $e4"
-else bad "vcm merge: relMSE $e1 -> $e4 (did not fall)"; fi
+# check CONDITION(a, b, da, db) A B MESSAGE: da, db are |a - 1|, |b - 1|
+check() {
+  if awk -v a="$2" -v b="$3" "BEGIN {da = a > 1 ? a - 1 : 1 - a; db = b > 1 ? b - 1 : 1 - b; exit !($1)}"; then
+    ok "$4"
+  else
+    bad "$4"
+  fi
+}
+check "db < da || db < 0.01" "$b1" "$b4" "vcm merge: block median $b1 at $n passes, $b4 at $((4 * n)) (towards 1, or within 1 %)"
+check "b < a" "$e1" "$e4" "vcm merge: relMSE $e1 -> $e4 (falls)"
 
 render "$tmp/k4.exr" "$@" -i vcm --vcm-mode merge --merge-paths 4 --spp "$n" --seed 1
 bk=$(key "$tmp/k4.exr" block_median_ratio) ek=$(key "$tmp/k4.exr" relmse)
-if awk -v a="$b1" -v b="$bk" 'BEGIN {da = a > 1 ? a - 1 : 1 - a; db = b > 1 ? b - 1 : 1 - b; exit !(db <= da + 0.002 || db < 0.01)}'; then
-  ok "vcm merge, 4 light paths per pixel: block median $bk at $n passes (one path: $b1)"
-else
-  bad "vcm merge, 4 light paths per pixel: block median $bk at $n passes (one path: $b1)"
-fi
-if awk -v a="$e1" -v b="$ek" 'BEGIN {exit !(b < 0.8 * a)}'; then ok "vcm merge, 4 light paths per pixel: relMSE $ek (one path: $e1)"
-else bad "vcm merge, 4 light paths per pixel: relMSE $ek, not below 0.8 of one path's $e1"; fi
+check "db <= da + 0.002 || db < 0.01" "$b1" "$bk" \
+  "vcm merge, 4 light paths per pixel: block median $bk at $n passes (one path: $b1; within 1 % or no further off)"
+check "b < 0.8 * a" "$e1" "$ek" "vcm merge, 4 light paths per pixel: relMSE $ek (one path: $e1; below 0.8 of it)"
 
 exit $fail
