@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "core/rng.h"
+#include "core/sampling.h"
 #include "spatial/pointkd.h"
 #include "test_util.h"
 
@@ -46,6 +47,11 @@ static void run(const char *name, int kind, uint32_t n)
         }
         if (kind == 3 && i % 3 == 1) /* duplicates */
             memcpy(p, pts + 4 * (i - 1), 3 * sizeof(float));
+        if (kind == 4 && i < 150) { /* a shell: many nearly equal distances from its centre */
+            cdl_vec3 d = cdl_sample_uniform_sphere(p[0], p[1]);
+            float rad = 0.05f + 1e-6f * (p[2] - 0.5f);
+            p[0] = 0.5f + rad * d.x, p[1] = 0.5f + rad * d.y, p[2] = 0.5f + rad * d.z;
+        }
         p[3] = 0.0f;
     }
     cdl_kdtree t;
@@ -58,6 +64,8 @@ static void run(const char *name, int kind, uint32_t n)
     int knn_bad = 0, ball_bad = 0, order_bad = 0, guess_bad = 0;
     for (int qi = 0; qi < 300; qi++) {
         cdl_vec3 q = cdl_v3(cdl_rng_float(&r) * 1.2f - 0.1f, cdl_rng_float(&r), cdl_rng_float(&r));
+        if (kind == 4 && qi % 2)
+            q = cdl_v3(0.5f, 0.5f, 0.5f);
         uint32_t k = 1 + (uint32_t)(cdl_rng_float(&r) * 63.0f);
         float max_d2 = qi % 2 ? 0.01f : INFINITY;
         for (uint32_t i = 0; i < n; i++) {
@@ -81,25 +89,33 @@ static void run(const char *name, int kind, uint32_t n)
             if (j && d2[j] < d2[j - 1])
                 order_bad++;
         }
-        /* the guessed ball and selection: the same distances (as a set;
-         * the largest first) whatever the guess: carried over from the last
+        /* the guessed ball and the k-th distance by histogram: right
+         * whatever the guess: carried over from the last
          * query, none, far too small, or so large the buffer overflows */
         float g = qi % 5 == 0 ? 1e-8f : qi % 7 == 0 ? 10.0f : qi % 11 == 0 ? 0.0f : guess;
         guess = g;
         uint32_t cap = k + 1 + (uint32_t)(qi % 3) * k;
-        uint32_t gn = cdl_kd_knn_guess(&t, q, k, max_d2, &guess, cap, gout, gd2);
-        if (gn != want)
+        float kth;
+        uint32_t gn = cdl_kd_knn_guess(&t, q, k, max_d2, &guess, cap, gout, gd2, &kth);
+        /* with k points in reach: kth is the k-th distance, and the points
+         * include every one nearer; else exactly those within max_d2 */
+        if (want == k ? kth != sorted[k - 1] || gn < k : kth != -1.0f || gn != want)
             guess_bad++;
-        for (uint32_t j = 1; j < gn; j++)
-            if (gd2[j] > gd2[0])
+        uint32_t nearer = 0;
+        for (uint32_t j = 0; j < gn; j++) {
+            if (all[gout[j]] != gd2[j] || gd2[j] > max_d2)
                 guess_bad++;
-        for (uint32_t j = 0; j < gn; j++)
-            if (all[gout[j]] != gd2[j])
-                guess_bad++;
-        qsort(gd2, gn, sizeof(float), cmp_float);
-        for (uint32_t j = 0; j < gn && j < want; j++)
-            if (gd2[j] != sorted[j])
-                guess_bad++;
+            nearer += want < k || gd2[j] < kth;
+        }
+        uint32_t expect_nearer = 0;
+        for (uint32_t j = 0; j < want; j++)
+            expect_nearer += want < k || sorted[j] < kth;
+        if (nearer != expect_nearer)
+            guess_bad++;
+        for (uint32_t j = 1; j < gn; j++) /* no point twice */
+            for (uint32_t i = 0; i < j; i++)
+                if (gout[i] == gout[j])
+                    guess_bad++;
         free(sorted);
         /* ball query: exactly the points within r */
         float r2 = 0.002f + 0.02f * cdl_rng_float(&r);
@@ -133,6 +149,7 @@ int main(void)
     run("clustered", 1, 5000);
     run("coplanar", 2, 3000);
     run("duplicates", 3, 3000);
+    run("shell", 4, 3000);
     run("tiny", 0, 3);
     cdl_kdtree t;
     cdl_error err;

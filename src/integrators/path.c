@@ -40,7 +40,8 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
     cdl_sampler_2d(smp, &u1, &u2);
     if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
-    cdl_vec3 f = cdl_bsdf_eval(b, wo, ls.wi, 0);
+    float pdf_b;
+    cdl_vec3 f = cdl_bsdf_eval_pdf(b, wo, ls.wi, 0, &pdf_b);
     if (cdl_is_black(f))
         return f;
     (*rays)++;
@@ -48,7 +49,7 @@ static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float pdf_l = ls.pdf * pmf;
     float cos = fabsf(cdl_dot(ls.wi, b->frame.n));
-    float w = ls.delta ? 1.0f : cdl_power_heuristic(pdf_l, cdl_bsdf_pdf(b, wo, ls.wi));
+    float w = ls.delta ? 1.0f : cdl_power_heuristic(pdf_l, pdf_b);
     return cdl_scale(cdl_mul(f, ls.Li), cos * w / pdf_l);
 }
 

@@ -444,6 +444,23 @@ cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
     float k = perturbation_factor(b, wi);
     return k > 0.0f ? cdl_scale(f, k) : cdl_v3(0.0f, 0.0f, 0.0f);}
 
+/* eval and pdf in one call: one change of frame and one lobe evaluation
+ * where the two calls would make them twice (next-event estimation). */
+cdl_vec3 cdl_bsdf_eval_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint, float *pdf)
+{
+    cdl_vec3 lo, li, zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    *pdf = 0.0f;
+    if (!is_opaque(b) || b->perturbed) {
+        *pdf = cdl_bsdf_pdf(b, wo, wi);
+        return cdl_bsdf_eval(b, wo, wi, adjoint);
+    }
+    if (!opaque_local(b, wo, wi, &lo, &li))
+        return zero;
+    cdl_vec3 f = opaque_eval(b, lo, li, pdf);
+    *pdf *= b->opacity;
+    return cdl_scale(f, b->opacity);
+}
+
 float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
 {
     if (b->perturbed && !(perturbation_factor(b, wi) > 0.0f))

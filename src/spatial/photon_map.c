@@ -96,16 +96,23 @@ static float kernel_area(cdl_kernel k, float r2)
     return k == CDL_KERNEL_CONE ? a / 3.0f : k == CDL_KERNEL_EPANECHNIKOV ? a * 0.5f : a;
 }
 
-/* The k nearest within the maximum radius (as a heap) and the radius of
- * the estimate: the k-th distance, or the maximum with fewer than k. */
+/* The k nearest within the maximum radius (with a guess, perhaps more)
+ * and the radius of the estimate: the k-th distance, or the maximum with
+ * fewer than k. The kernels weight the points beyond it 0. */
 static uint32_t gather(const cdl_photon_map *m, const cdl_pm_query *q, cdl_vec3 x, float *r2)
 {
     if (!m->n || !m->built || !q->k)
         return 0;
-    uint32_t n = q->guess && q->cap > q->k
-                     ? cdl_kd_knn_guess(&m->kd, x, q->k, q->max_r2, q->guess, q->cap, q->idx, q->d2)
-                     : cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
-    *r2 = n == q->k ? q->d2[0] : q->max_r2;
+    uint32_t n;
+    if (q->guess && q->cap > q->k) {
+        /* perhaps more than k points: the kernel of r2 leaves the others out */
+        float kth;
+        n = cdl_kd_knn_guess(&m->kd, x, q->k, q->max_r2, q->guess, q->cap, q->idx, q->d2, &kth);
+        *r2 = kth >= 0.0f ? kth : q->max_r2;
+    } else {
+        n = cdl_kd_knn_heap(&m->kd, x, q->k, q->max_r2, q->idx, q->d2);
+        *r2 = n == q->k ? q->d2[0] : q->max_r2;
+    }
     if (q->shrink > 0.0f && q->shrink < 1.0f)
         *r2 *= q->shrink;
     return *r2 > 0.0f ? n : 0;
@@ -147,6 +154,24 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     int lambert = b->type == CDL_MAT_DIFFUSE;
     float go = cdl_dot(wo, b->ng), so = cdl_dot(wo, b->frame.n) * (go < 0.0f ? -1.0f : 1.0f);
     cdl_vec3 fd = cdl_scale(b->kd, (float)CDL_INV_PI), zero = cdl_v3(0.0f, 0.0f, 0.0f);
+    if (lambert && !q->vis.fn) {
+        /* the same sum without a branch per photon (the signs of wi are as
+         * good as random there, and mispredicted): rejected photons weigh 0 */
+        if (!(go != 0.0f && so > 0.0f) || !n)
+            return zero;
+        float sg = go < 0.0f ? -1.0f : 1.0f;
+        cdl_vec3 ngs = cdl_scale(b->ng, sg), nss = cdl_scale(b->frame.n, sg);
+        float pr = 0.0f, pg = 0.0f, pb = 0.0f;
+        for (uint32_t i = 0; i < n; i++) {
+            const cdl_photon *ph = &m->ph[q->idx[i]];
+            float w = kernel_w(q->kernel, q->d2[i], r2);
+            cdl_vec3 wi = cdl_oct_decode_raw(ph->wi & 0x3fffffffu, 15);
+            int keep = w > 0.0f && !left_out(q, ph) && cdl_dot(wi, ngs) > 0.0f && cdl_dot(wi, nss) > 0.0f;
+            w = keep ? w : 0.0f;
+            pr += ph->power[0] * w, pg += ph->power[1] * w, pb += ph->power[2] * w;
+        }
+        return cdl_scale(cdl_mul(fd, cdl_v3(pr, pg, pb)), 1.0f / kernel_area(q->kernel, r2));
+    }
     for (uint32_t i = 0; i < n; i++) {
         const cdl_photon *ph = &m->ph[q->idx[i]];
         float w = kernel_w(q->kernel, q->d2[i], r2);

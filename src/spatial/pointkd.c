@@ -289,15 +289,26 @@ static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 
 {
     while (lo < hi) {
         if (hi - lo <= 16) {
+            if (c->n + (hi - lo) > c->cap) { /* near full: one at a time */
+                for (uint32_t i = lo; i < hi; i++) {
+                    uint32_t p = t->identity ? i : t->idx[i];
+                    float d = dist2(t, p, q);
+                    if (d <= r2) {
+                        if (c->n == c->cap)
+                            return -1;
+                        c->idx[c->n] = p;
+                        c->d2[c->n++] = d;
+                    }
+                }
+                return 0;
+            }
+            /* written always, kept by the count: no branch to mispredict */
             for (uint32_t i = lo; i < hi; i++) {
                 uint32_t p = t->identity ? i : t->idx[i];
                 float d = dist2(t, p, q);
-                if (d <= r2) {
-                    if (c->n == c->cap)
-                        return -1;
-                    c->idx[c->n] = p;
-                    c->d2[c->n++] = d;
-                }
+                c->idx[c->n] = p;
+                c->d2[c->n] = d;
+                c->n += d <= r2;
             }
             return 0;
         }
@@ -326,45 +337,65 @@ static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 
     return 0;
 }
 
-static void swap_at(uint32_t *idx, float *d2, uint32_t a, uint32_t b)
+/* The k-th smallest (1 <= k <= n) of d2[0, n), all in [0, hi], without
+ * moving them: a histogram of 256 bins over [lo, hi] finds the bin
+ * holding it, whose values (a contiguous range, the binning being
+ * monotone) are few enough to sort, or the next range to bin. */
+static float kth_smallest(const float *d2, uint32_t n, uint32_t k, float hi)
 {
-    float fd = d2[a];
-    uint32_t fi = idx[a];
-    d2[a] = d2[b];
-    idx[a] = idx[b];
-    d2[b] = fd;
-    idx[b] = fi;
-}
-
-/* Reorders so that [0, k) holds k smallest distances (quickselect with
- * a three-way partition: equal distances cannot stall it). */
-static void select_k(uint32_t *idx, float *d2, uint32_t n, uint32_t k)
-{
-    uint32_t lo = 0, hi = n; /* position k - 1 lies in [lo, hi) */
-    while (hi - lo > 1) {
-        float a = d2[lo], b = d2[lo + (hi - lo) / 2], c = d2[hi - 1];
-        float pv = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        uint32_t lt = lo, i = lo, gt = hi; /* [lo, lt) < pv, [lt, i) == pv, [gt, hi) > pv */
-        while (i < gt) {
-            if (d2[i] < pv)
-                swap_at(idx, d2, lt++, i++);
-            else if (d2[i] > pv)
-                swap_at(idx, d2, i, --gt);
-            else
-                i++;
+    enum { BINS = 256, FEW = 32 };
+    uint32_t hist[BINS];
+    float lo = 0.0f, few[FEW];
+    for (;;) {
+        if (!(hi > lo))
+            return lo; /* every candidate left is equal */
+        float scale = (float)BINS / (hi - lo);
+        memset(hist, 0, sizeof hist);
+        for (uint32_t i = 0; i < n; i++) {
+            float v = d2[i];
+            if (v >= lo && v <= hi) {
+                int b = (int)((v - lo) * scale);
+                hist[b < BINS - 1 ? b : BINS - 1]++;
+            }
         }
-        if (k - 1 < lt)
-            hi = lt;
-        else if (k - 1 >= gt)
-            lo = gt;
-        else
-            return;
+        int bin = 0;
+        while (k > hist[bin])
+            k -= hist[bin++];
+        /* the bin's values: their range, and the values while few */
+        float bmin = INFINITY, bmax = -INFINITY;
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            float v = d2[i];
+            if (v >= lo && v <= hi) {
+                int b = (int)((v - lo) * scale);
+                if ((b < BINS - 1 ? b : BINS - 1) == bin) {
+                    bmin = v < bmin ? v : bmin;
+                    bmax = v > bmax ? v : bmax;
+                    if (m < FEW)
+                        few[m] = v;
+                    m++;
+                }
+            }
+        }
+        if (m <= FEW) {
+            for (uint32_t i = 1; i < m; i++) { /* insertion sort */
+                float v = few[i];
+                uint32_t j = i;
+                for (; j > 0 && few[j - 1] > v; j--)
+                    few[j] = few[j - 1];
+                few[j] = v;
+            }
+            return few[k - 1];
+        }
+        lo = bmin;
+        hi = bmax;
     }
 }
 
 uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, float *guess, uint32_t cap,
-                          uint32_t *out, float *d2)
+                          uint32_t *out, float *d2, float *kth)
 {
+    *kth = -1.0f;
     if (k == 0 || t->n == 0)
         return 0;
     float r2 = guess && *guess > 0.0f ? *guess : 0.0f;
@@ -381,21 +412,18 @@ uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max
             r2 *= c.n ? 1.3f * (float)k / (float)c.n : 4.0f;
             continue;
         }
-        uint32_t n = c.n < k ? c.n : k;
-        if (c.n > k)
-            select_k(out, d2, c.n, k);
-        uint32_t far = 0;
-        for (uint32_t i = 1; i < n; i++)
-            far = d2[i] > d2[far] ? i : far;
-        if (n)
-            swap_at(out, d2, 0, far);
-        if (n == k)
-            *guess = d2[0] * 1.05f; /* the next query's, a little wider */
-        return n;
+        if (c.n >= k) {
+            *kth = kth_smallest(d2, c.n, k, r2);
+            *guess = *kth * 1.05f; /* the next query's, a little wider */
+        }
+        return c.n;
     }
     uint32_t n = cdl_kd_knn_heap(t, q, k, max_d2, out, d2);
-    if (guess && n == k)
-        *guess = d2[0] * 1.05f;
+    if (n == k) {
+        *kth = d2[0];
+        if (guess)
+            *guess = d2[0] * 1.05f;
+    }
     return n;
 }
 

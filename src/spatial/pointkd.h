@@ -36,15 +36,19 @@ uint32_t cdl_kd_knn(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, u
 uint32_t cdl_kd_knn_heap(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, uint32_t *out,
                          float *d2);
 
-/* The same as cdl_kd_knn_heap (the same points, ties aside) for a caller
- * whose queries are coherent (neighbouring pixels): a ball query of the
- * radius^2 *guess, then a selection of the k nearest, which is cheaper
- * than keeping a heap when k is large; the heap when the ball holds too
- * few or more than cap points after a few tries. out and d2 hold cap >= k
- * entries. *guess becomes the next query's (the k-th distance, widened a
- * little); 0 to start. */
+/* For a caller whose queries are coherent (neighbouring pixels) and who
+ * weights points by a kernel of the k-th distance: a ball query of the
+ * radius^2 *guess, and the k-th smallest distance found by a histogram,
+ * which is cheaper than keeping a heap or selecting when k is large. The
+ * points come back unsorted, and may be more than k: all those the ball
+ * held, which include every point nearer than the k-th. *kth is the k-th
+ * smallest squared distance, or -1 when fewer than k points lie within
+ * max_d2 (then those are all returned). Falls back to the heap (exactly
+ * k points) when the ball holds too few or more than cap points after a
+ * few tries. out and d2 hold cap >= k entries. *guess becomes the next
+ * query's (the k-th distance, widened a little); 0 to start. */
 uint32_t cdl_kd_knn_guess(const cdl_kdtree *t, cdl_vec3 q, uint32_t k, float max_d2, float *guess, uint32_t cap,
-                          uint32_t *out, float *d2);
+                          uint32_t *out, float *d2, float *kth);
 
 /* For a caller that has moved point idx[i] to position i (tree order):
  * the indirection becomes the identity, and traversal cache-friendly. */
