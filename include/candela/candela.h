@@ -177,6 +177,17 @@ CDL_API int cdl_image_diff(const cdl_image *test, const cdl_image *ref, cdl_diff
 /* False-colour map of the per-pixel relative error (log scale, 1e-4 blue to 1 red). */
 CDL_API int cdl_image_diff_heatmap(const cdl_image *test, const cdl_image *ref, cdl_image **out,
                                    cdl_error *err);
+/* FLIP (Andersson et al. 2020) of test against ref: *mean the mean of the
+ * per-pixel error in [0, 1]. hdr = 0: LDR-FLIP of the linear RGB pixels
+ * clamped to [0, 1] (a PNG as loaded); hdr = 1: HDR-FLIP (Andersson et al.
+ * 2021), the largest LDR-FLIP over ACES-tone-mapped exposures chosen from
+ * ref's median and largest luminance. ppd: pixels per degree of visual
+ * angle, in [1, 1000]; <= 0 means 67.02 (0.7 m from a 0.7 m wide 3840-pixel
+ * monitor). map may be NULL, else it receives the per-pixel error coloured
+ * with magma (black 0 to pale yellow 1), stored linear so that
+ * cdl_image_save(.png, exposure 0) writes the map's colours. */
+CDL_API int cdl_image_flip(const cdl_image *test, const cdl_image *ref, int hdr, double ppd, double *mean,
+                           cdl_image **map, cdl_error *err);
 
 /* ---- renders ---------------------------------------------------------- */
 

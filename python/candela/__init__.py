@@ -21,6 +21,7 @@ passes done.
 """
 
 import ctypes
+import os
 import signal
 import threading
 
@@ -29,7 +30,7 @@ import numpy as np
 from . import _lib
 from ._lib import lib
 
-__all__ = ["Error", "UsageError", "InputError", "Scene", "Renderer", "render", "diff", "read", "write",
+__all__ = ["Error", "UsageError", "InputError", "Scene", "Renderer", "render", "diff", "flip", "read", "write",
            "options", "integrators", "version"]
 
 
@@ -409,6 +410,32 @@ def diff(test, ref):
         d = _lib.Diff()
         _call(lib.cdl_image_diff, a, b, ctypes.byref(d))
         return {k: getattr(d, k) for k, _ in _lib.Diff._fields_}
+    finally:
+        lib.cdl_image_release(a)
+        lib.cdl_image_release(b)
+
+
+def flip(test, ref, hdr=None, ppd=None, map=False):
+    """Mean FLIP error of test against ref, in [0, 1] (Andersson et al. 2020;
+    0 for identical images). test and ref are (H, W, 3) linear RGB arrays or
+    image file names. hdr=None or True: HDR-FLIP (exposures from ref's median
+    to its largest luminance, ACES tone mapping); hdr=False: LDR-FLIP of the
+    pixels clamped to [0, 1] (a PNG as read). ppd: pixels per degree, 1 to
+    1000 (None: 67.02). With map=True returns (mean, map), map an (H, W, 3)
+    float32 array of the per-pixel error in magma colours, linear RGB (as
+    candela.write(..png) expects)."""
+    if isinstance(test, (str, os.PathLike)):
+        test = read(test)
+    if isinstance(ref, (str, os.PathLike)):
+        ref = read(ref)
+    a = b = None
+    try:
+        a, b = _from_array(test), _from_array(ref)
+        mean = ctypes.c_double()
+        m = ctypes.c_void_p()
+        _call(lib.cdl_image_flip, a, b, 1 if hdr is None or hdr else 0,
+              0.0 if ppd is None else float(ppd), ctypes.byref(mean), ctypes.byref(m) if map else None)
+        return (mean.value, _to_array(m.value)) if map else mean.value
     finally:
         lib.cdl_image_release(a)
         lib.cdl_image_release(b)

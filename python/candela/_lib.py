@@ -85,6 +85,7 @@ _sig = {
     "cdl_image_save": (c_int, [c_void_p, c_char_p, c_float, P(Error)]),
     "cdl_image_diff": (c_int, [c_void_p, c_void_p, P(Diff), P(Error)]),
     "cdl_image_diff_heatmap": (c_int, [c_void_p, c_void_p, P(c_void_p), P(Error)]),
+    "cdl_image_flip": (c_int, [c_void_p, c_void_p, c_int, c_double, P(c_double), P(c_void_p), P(Error)]),
     "cdl_renderer_create": (c_int, [c_void_p, c_void_p, P(c_void_p), P(Error)]),
     "cdl_renderer_release": (None, [c_void_p]),
     "cdl_renderer_render": (c_int, [c_void_p, PROGRESS_FN, c_void_p, P(Error)]),

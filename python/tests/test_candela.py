@@ -215,3 +215,22 @@ def test_discovery():
     vcm = {o["name"]: o for o in candela.options("vcm")}
     assert vcm["vcm_mode"]["default"] == "full" and "radius" in vcm and "alpha" in vcm and "photons" not in vcm
     assert candela.version().count(".") == 2
+
+
+def test_flip(tmp_path):
+    rng = np.random.default_rng(2)
+    a = rng.random((24, 32, 3), dtype=np.float32)
+    assert candela.flip(a, a) == 0.0 and candela.flip(a, a, hdr=False) == 0.0
+    # LDR-FLIP is symmetric; more noise, more error
+    noisy = [np.clip(a + s * rng.standard_normal(a.shape).astype(np.float32), 0, 1) for s in (0.02, 0.2)]
+    e = [candela.flip(n, a, hdr=False) for n in noisy]
+    assert 0 < e[0] < e[1] < 1 and candela.flip(a, noisy[0], hdr=False) == e[0]
+    mean, m = candela.flip(noisy[1], a, ppd=30, map=True)
+    assert 0 < mean < 1 and m.shape == a.shape and m.dtype == np.float32
+    candela.write(tmp_path / "a.png", a)
+    candela.write(tmp_path / "n.png", noisy[1])
+    assert abs(candela.flip(tmp_path / "n.png", tmp_path / "a.png", hdr=False) - e[1]) < 0.02
+    with pytest.raises(candela.Error):
+        candela.flip(a, a[:10])
+    with pytest.raises(candela.UsageError):
+        candela.flip(a, a, ppd=0.5)

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "film/flip.h"
 #include "film/image.h"
 #include "film/metrics.h"
 
@@ -113,5 +114,38 @@ int cdl_image_diff_heatmap(const cdl_image *test, const cdl_image *ref, cdl_imag
         free(*out);
         *out = NULL;
     }
+    return rc;
+}
+
+int cdl_image_flip(const cdl_image *test, const cdl_image *ref, int hdr, double ppd, double *mean,
+                   cdl_image **map, cdl_error *err)
+{
+    if (map)
+        *map = NULL;
+    if (!test || !ref || !mean)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_image_flip: no image or no place for the mean");
+    if (hdr != 0 && hdr != 1)
+        return cdl_error_set(err, CDL_ERR_USAGE, "", 0, "cdl_image_flip: hdr must be 0 or 1, got %d", hdr);
+    cdl_image *m = NULL;
+    float *values = NULL;
+    int rc = 0;
+    if (map) {
+        size_t n = (size_t)test->width * (size_t)test->height;
+        if (!(rc = new_image(&m, err)) && !(rc = cdl_image_alloc(m, test->width, test->height, err)) &&
+            !(values = malloc(n * sizeof *values)))
+            rc = cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory");
+    }
+    if (!rc)
+        rc = cdl_flip(test, ref, hdr, ppd, values, mean, NULL, err);
+    if (!rc && m) {
+        size_t n = (size_t)test->width * (size_t)test->height;
+        for (size_t p = 0; p < n; p++)
+            cdl_flip_magma(values[p], m->rgb + 3 * p);
+        *map = m;
+    } else if (m) {
+        cdl_image_free(m);
+        free(m);
+    }
+    free(values);
     return rc;
 }

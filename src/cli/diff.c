@@ -1,5 +1,6 @@
-/* candela diff TEST REF [--heatmap OUT.png] [--region X0,Y0,X1,Y1]: error
- * metrics of one image against a reference (DESIGN.md, Verification). */
+/* candela diff TEST REF [--heatmap OUT.png] [--flip-map OUT.png] [--ppd N]
+ * [--region X0,Y0,X1,Y1]: error metrics of one image against a reference
+ * (DESIGN.md, Verification), FLIP among them. */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -56,12 +57,14 @@ static int crop(cdl_image **img, const char *path, const int *rg, cdl_error *err
 
 int cli_diff(int argc, char **argv)
 {
-    const char *files[2] = {NULL, NULL}, *heat = NULL;
+    const char *files[2] = {NULL, NULL}, *heat = NULL, *flipmap = NULL;
     int nfiles = 0, region[4] = {0, 0, 0, 0}, has_region = 0;
+    double ppd = 0.0;
     cdl_error err;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            printf("usage: candela diff TEST REF [--heatmap OUT.png] [--region X0,Y0,X1,Y1]\n"
+            printf("usage: candela diff TEST REF [--heatmap OUT.png] [--flip-map OUT.png] [--ppd N]\n"
+                   "                    [--region X0,Y0,X1,Y1]\n"
                    "Prints RMSE, relative MSE (mean of (t-r)^2/(r^2+0.01)), mean absolute\n"
                    "error and the ratio of image means; for images with rare fireflies also\n"
                    "the relative MSE without the largest 0.1%% of per-pixel terms and the\n"
@@ -70,7 +73,15 @@ int cli_diff(int argc, char **argv)
                    "--heatmap writes a\n"
                    "false-colour map of the per-pixel relative error (log scale, 1e-4 blue\n"
                    "to 1 red). --region compares only the pixels x in [X0, X1), y in [Y0, Y1)\n"
-                   "(y = 0 the top row), e.g. one room of an interior.\n");
+                   "(y = 0 the top row), e.g. one room of an interior.\n"
+                   "flip_ldr / flip_hdr is the mean FLIP error in [0, 1] (Andersson et al.\n"
+                   "2020, 0 = identical): LDR-FLIP when both files are PNG (the sRGB\n"
+                   "values as displayed), otherwise HDR-FLIP (Andersson et al. 2021: the\n"
+                   "largest LDR-FLIP over ACES-tone-mapped exposures from the reference's\n"
+                   "median to its largest luminance). --ppd sets the viewing condition in\n"
+                   "pixels per degree, 1 to 1000 (default 67.02: 0.7 m from a 0.7 m wide\n"
+                   "3840-pixel monitor). --flip-map writes the per-pixel FLIP error with\n"
+                   "the magma colour map (black 0 to pale yellow 1).\n");
             return 0;
         }
         if (!strcmp(argv[i], "--heatmap")) {
@@ -80,6 +91,24 @@ int cli_diff(int argc, char **argv)
             if (!cli_has_ext(heat, ".png"))
                 return usage_error(&err, "--heatmap", "the heat map is written as PNG: name it *.png"),
                        cli_report(&err);
+        } else if (!strcmp(argv[i], "--flip-map")) {
+            if (i + 1 >= argc)
+                return usage_error(&err, "--flip-map", "expects a file name"), cli_report(&err);
+            flipmap = argv[++i];
+            if (!cli_has_ext(flipmap, ".png"))
+                return usage_error(&err, "--flip-map", "the FLIP map is written as PNG: name it *.png"),
+                       cli_report(&err);
+        } else if (!strcmp(argv[i], "--ppd")) {
+            char *end;
+            if (i + 1 >= argc)
+                return usage_error(&err, "--ppd", "expects pixels per degree, 1 to 1000"), cli_report(&err);
+            errno = 0;
+            ppd = strtod(argv[++i], &end);
+            if (end == argv[i] || *end || errno || !(ppd >= 1.0 && ppd <= 1000.0)) {
+                char msg[500];
+                snprintf(msg, sizeof msg, "expected pixels per degree from 1 to 1000, got '%.400s'", argv[i]);
+                return usage_error(&err, "--ppd", msg), cli_report(&err);
+            }
         } else if (!strcmp(argv[i], "--region")) {
             if (i + 1 >= argc)
                 return usage_error(&err, "--region", "expects X0,Y0,X1,Y1"), cli_report(&err);
@@ -96,8 +125,10 @@ int cli_diff(int argc, char **argv)
     }
     if (nfiles != 2)
         return usage_error(&err, "diff", "expects TEST and REF images"), cli_report(&err);
-    cdl_image *t = NULL, *r = NULL, *h = NULL;
+    cdl_image *t = NULL, *r = NULL, *h = NULL, *fm = NULL;
     cdl_diff m;
+    double flip = 0.0;
+    int ldr = cli_has_ext(files[0], ".png") && cli_has_ext(files[1], ".png");
     int rc = cdl_image_load(files[0], &t, &err);
     if (!rc)
         rc = cdl_image_load(files[1], &r, &err);
@@ -113,18 +144,23 @@ int cli_diff(int argc, char **argv)
         if (!rc)
             rc = cdl_image_save(h, heat, 0.0f, &err);
     }
+    if (!rc)
+        rc = cdl_image_flip(t, r, !ldr, ppd, &flip, flipmap ? &fm : NULL, &err);
+    if (!rc && flipmap)
+        rc = cdl_image_save(fm, flipmap, 0.0f, &err);
     cdl_image_release(t);
     cdl_image_release(r);
     cdl_image_release(h);
+    cdl_image_release(fm);
     if (rc) {
         if (err.code == CDL_ERR_INPUT && strcmp(err.file, files[0]) && strcmp(err.file, files[1]) &&
-            !(heat && !strcmp(err.file, heat)))
+            !(heat && !strcmp(err.file, heat)) && !(flipmap && !strcmp(err.file, flipmap)))
             snprintf(err.file, sizeof err.file, "%s", files[0]); /* size mismatch names TEST */
         return cli_report(&err);
     }
     printf("rmse %.6g  relmse %.6g  mae %.6g  mean_ratio %.6f  relmse_trimmed %.6g  "
-           "block_median_ratio %.6f  block_dev32 %.6f  (mean test %.6g, ref %.6g)\n",
+           "block_median_ratio %.6f  block_dev32 %.6f  (mean test %.6g, ref %.6g)  %s %.6f\n",
            m.rmse, m.relmse, m.mae, m.mean_ratio, m.relmse_trimmed, m.block_median_ratio, m.block_dev32,
-           m.mean_test, m.mean_ref);
+           m.mean_test, m.mean_ref, ldr ? "flip_ldr" : "flip_hdr", flip);
     return 0;
 }
