@@ -130,12 +130,14 @@
   const canvA = $("canvas-a"), canvB = $("canvas-b");
   let VW = 512, VH = 512;
   function layout() {
-    const avail = Math.max(256, Math.min(document.documentElement.clientWidth - 40, 1400));
+    let avail = Math.max(256, document.documentElement.clientWidth - 40);
+    if (avail >= 1100) avail -= 480; // the plots go beside the viewer
     const per = S.side ? Math.floor((avail - 8) / 2) : avail;
     VW = Math.min(per, 1024);
     VH = Math.max(128, Math.min(Math.round(VW * H / W), Math.round(window.innerHeight * 0.7) || VW, 900));
     for (const c of [canvA, canvB]) { c.width = VW; c.height = VH; c.style.width = VW + "px"; c.style.height = VH + "px"; }
     $("split-pos").style.width = VW + "px";
+    $("viewer-section").style.width = (S.side ? 2 * VW + 8 : VW) + "px";
   }
   function fitZoom() {
     let z = ZOOMS[0];
@@ -426,7 +428,7 @@
       for (const m of [1, 2, 3, 4, 5, 6, 7, 8, 9]) {
         const v = m * Math.pow(10, d);
         if (v < lo * 0.999 || v > hi * 1.001) continue;
-        const label = m === 1 || (span < 1e3 && (m === 2 || m === 5)) || span < 12;
+        const label = m === 1 || (span < 1e3 && (m === 2 || m === 5)) || (span < 3 && m !== 7 && m !== 9);
         out.push([v, label]);
       }
     }
