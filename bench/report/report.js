@@ -329,7 +329,7 @@
   /* ---------- thumbnails of every image ---------- */
   const thumbs = [];
   function buildGrid() {
-    const tw = Math.min(128, W), th = Math.max(1, Math.round(tw * H / W));
+    const tw = Math.min(96, W), th = Math.max(1, Math.round(tw * H / W));
     const table = document.createElement("table");
     table.className = "grid";
     const cols = budgets.length ? budgets : [null];
@@ -537,6 +537,14 @@
   S.zoom = fitZoom();
   buildGrid();
   buildPlots();
+  /* A view given in the URL: #a=ID&b=ID&mode=relmse&exposure=1&split=1&side=1 */
+  for (const kv of (location.hash || "").replace(/^#/, "").split("&")) {
+    const [k, v] = kv.split("=").map(decodeURIComponent);
+    if ((k === "a" || k === "b") && byId.has(v)) S[k] = byId.get(v);
+    else if (k === "mode" && ["image", "relmse", "flip"].includes(v)) S.mode = v;
+    else if (k === "exposure" && isFinite(Number(v))) S.exposure = Math.max(-10, Math.min(10, Number(v)));
+    else if (k === "split" || k === "side") { S[k] = v === "1"; if (S.side) { S.split = false; layout(); S.zoom = fitZoom(); } }
+  }
   redraw();
   const readyMs = performance.now();
   const timing = { scripts_loaded_ms: T0, decoded_ms: T1, ready_ms: readyMs };
