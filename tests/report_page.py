@@ -5,7 +5,8 @@ Renders the Cornell box at 64x64 with path, bdpt and pm at three short
 budgets, opens the page with a self-test hash (index.html#selftest=...) that
 switches the method with the number key, the budget by clicking the plot
 point and the exposure with its slider (the code paths of the UI), and reads
-back a pixel of the viewer canvas. Checks: no script or console errors, the
+back a pixel of the viewer canvas; then it presses every other key once and
+wheels, drags and clicks an inset and a thumbnail. Checks: no script or console errors, the
 page ready in under a second (performance.now() at the end of its start-up),
 and the canvas pixel equals the sRGB tonemap of value x 2^exposure computed
 here from that method's EXR, within 2/255, at a pixel where the other images
@@ -103,6 +104,8 @@ def check_page(label, chromium, index, cdl, exr_dir, ref_path, method, budget, e
         bad(f"{label}: self-test failed in the page: {res['error']} {res.get('errors')}")
         return
     errs = res.get("errors", []) + console
+    if not res.get("keys_exercised"):
+        bad(f"{label}: the self-test did not exercise the other controls")
     if errs:
         bad(f"{label}: script/console errors: {errs}")
     else:

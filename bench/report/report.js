@@ -526,6 +526,19 @@
     Object.assign(res, { shown: IMGS[S.a].id, method: IMGS[S.a].method, budget: IMGS[S.a].budget, exposure: S.exposure,
       zoom: S.zoom, x: x, y: y, canvas_xy: [cx, cy], canvas: [px[0], px[1], px[2]],
       page_value: f, page_expected: f.map((v) => srgb(v * sc)) });
+    /* Then every other control once (errors land in CDL_ERRORS), back to the start. */
+    const keys = ["m", "f", "i", "s", " ", "s", "d", "d", "+", "-", "z", "[", "]", "x", "o", "ArrowLeft", "ArrowRight", "ArrowUp", "ArrowDown"];
+    keys.forEach((k) => key(k));
+    res.keys_exercised = keys.length;
+    const mid = canvA.getBoundingClientRect();
+    canvA.dispatchEvent(new WheelEvent("wheel", { deltaY: -1, clientX: mid.left + VW / 3, clientY: mid.top + VH / 3, bubbles: true, cancelable: true }));
+    canvA.dispatchEvent(new MouseEvent("mousedown", { clientX: mid.left + 10, clientY: mid.top + 10, bubbles: true }));
+    canvA.dispatchEvent(new MouseEvent("mousemove", { clientX: mid.left + 30, clientY: mid.top + 25, bubbles: true }));
+    window.dispatchEvent(new MouseEvent("mouseup", { bubbles: true }));
+    const ins = document.querySelector(".inset canvas");
+    if (ins) ins.dispatchEvent(new MouseEvent("click", { bubbles: true }));
+    const thumb = document.querySelector("table.grid canvas");
+    if (thumb) thumb.dispatchEvent(new MouseEvent("click", { bubbles: true, shiftKey: true }));
     return res;
   }
 
