@@ -465,6 +465,38 @@ static void test_materials(void)
     if (!rc)
         cdl_scene_free(&s);
 
+    /* pbrt (v3 and v4) names the falloff width "conedeltaangle": 10 of a
+     * 30-degree cone starts the falloff at 20 degrees, without a warning */
+    snprintf(text, sizeof text,
+             "WorldBegin\nLightSource \"spot\" \"rgb I\" [1 1 1] \"float coneangle\" 30 "
+             "\"float conedeltaangle\" 10\n%s", TRI);
+    write_file("spot2.pbrt", text);
+    warned = 0;
+    prev = cdl_log_push(&count);
+    rc = load("spot2.pbrt", &s, &set, &err);
+    cdl_log_pop(prev);
+    CHECK(!rc && warned == 0 && s.nlights == 1 &&
+              fabsf(s.lights[0].cos_falloff - cosf(20.0f * CDL_PI / 180.0f)) < 1e-6f &&
+              fabsf(s.lights[0].cos_total - cosf(30.0f * CDL_PI / 180.0f)) < 1e-6f,
+          "spot conedeltaangle 10 of coneangle 30: falloff from cos %g (cos 20 deg), %d warnings",
+          rc ? 0.0 : (double)s.lights[0].cos_falloff, warned);
+    if (!rc)
+        cdl_scene_free(&s);
+
+    /* pbrt-v4's thindielectric: a dielectric of its eta, with a warning (it
+     * was an opaque matte, which hid the light behind a pane) */
+    snprintf(text, sizeof text, "WorldBegin\nMaterial \"thindielectric\" \"float eta\" 1.33\n%s%s", LIGHT, TRI);
+    write_file("thin.pbrt", text);
+    warned = 0;
+    prev = cdl_log_push(&count);
+    rc = load("thin.pbrt", &s, &set, &err);
+    cdl_log_pop(prev);
+    CHECK(!rc && warned == 1 && s.mats[s.tri_mat[0]].type == CDL_MAT_DIELECTRIC &&
+              fabsf(s.mats[s.tri_mat[0]].eta - 1.33f) < 1e-6f,
+          "thindielectric as a dielectric of eta 1.33, with %d warning", warned);
+    if (!rc)
+        cdl_scene_free(&s);
+
     /* an area light on Material "none" still emits (pbrt lets rays through
      * the surface; candela's is black), with a warning */
     snprintf(text, sizeof text,

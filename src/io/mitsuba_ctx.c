@@ -238,6 +238,19 @@ const cdl_mts_id *cdl_mts_find_id(cdl_mts_ctx *c, const char *id)
     return NULL;
 }
 
+cdl_xml_node *cdl_mts_find_decl(cdl_mts_ctx *c, const char *id)
+{
+    for (int d = c->depth - 1; d >= 0; d--) {
+        cdl_xml_node *r = c->roots[d];
+        for (int i = 0; r && i < r->nkids; i++) {
+            const char *k = cdl_xml_attr_get(&r->kids[i], "id");
+            if (k && !strcmp(k, id))
+                return &r->kids[i];
+        }
+    }
+    return NULL;
+}
+
 int cdl_mts_add_id(cdl_mts_ctx *c, const cdl_xml_node *n, const cdl_mts_id *v)
 {
     if (cdl_mts_find_id(c, v->id))

@@ -215,8 +215,14 @@ int cdl_mts_emitter(cdl_mts_ctx *c, cdl_xml_node *n)
     if ((rc = cdl_mts_transform(c, n, "to_world", &m)))
         return rc;
     cdl_mts_prop(c, n, "sampling_weight");
-    if (!strcmp(type, "area"))
-        return cdl_mts_error(c, n->line, "emitter \"area\" must be inside a <shape>");
+    if (!strcmp(type, "area")) {
+        if (!cdl_xml_attr_get(n, "id"))
+            return cdl_mts_error(c, n->line, "emitter \"area\" must be inside a <shape> or have an id that "
+                                             "shapes refer to");
+        for (int k = 0; k < n->nkids; k++) /* read where a shape refers to it */
+            n->kids[k].used = 1;
+        return 0;
+    }
     if (!strcmp(type, "point")) {
         if ((rc = cdl_mts_color_prop(c, n, "intensity", cdl_v3(1, 1, 1), &v, NULL)) ||
             (rc = check_emission(c, n->line, "point intensity", v)) ||

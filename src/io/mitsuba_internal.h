@@ -61,6 +61,7 @@ typedef struct cdl_mts_ctx {
     cdl_vec3 sky_axes[3];
     char sky_file[1024];
     char buf[4096];         /* an attribute after $variable substitution */
+    cdl_xml_node *roots[CDL_MTS_MAX_INCLUDE + 1]; /* the open documents, outermost first */
 } cdl_mts_ctx;
 
 /* Error / warning at file:line of the current file (errors return CDL_ERR_INPUT). */
@@ -107,6 +108,9 @@ int cdl_mts_define(cdl_mts_ctx *c, const char *name, size_t len, const char *val
  * resolver does. */
 int cdl_mts_add_path(cdl_mts_ctx *c, const cdl_xml_node *n);
 const cdl_mts_id *cdl_mts_find_id(cdl_mts_ctx *c, const char *id);
+/* The top-level element with this id in any open document, declared before
+ * or after (innermost document first), or NULL. */
+cdl_xml_node *cdl_mts_find_decl(cdl_mts_ctx *c, const char *id);
 
 /* mitsuba_shapes.c */
 int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n);

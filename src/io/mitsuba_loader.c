@@ -382,6 +382,15 @@ static int element(cdl_mts_ctx *c, cdl_xml_node *n)
     return 0;
 }
 
+/* A top-level area emitter is read by the shapes that refer to it (Mitsuba
+ * 3's spelling); one that no shape refers to lights nothing, and says so. */
+static void unreferenced_area(cdl_mts_ctx *c, const cdl_xml_node *n)
+{
+    const char *id = cdl_xml_attr_get(n, "id"), *type = cdl_xml_attr_get(n, "type");
+    if (!strcmp(n->name, "emitter") && id && type && !strcmp(type, "area") && !cdl_mts_find_id(c, id))
+        cdl_mts_warn(c, n->line, "area emitter \"%s\": no shape refers to it, so it emits nowhere", id);
+}
+
 static int read_file(cdl_mts_ctx *c, const char *path, int line)
 {
     if (c->depth >= CDL_MTS_MAX_INCLUDE)
@@ -392,7 +401,7 @@ static int read_file(cdl_mts_ctx *c, const char *path, int line)
         return rc;
     const char *outer = c->file;
     c->file = path;
-    c->depth++;
+    c->roots[c->depth++] = &doc.root;
     if (strcmp(doc.root.name, "scene")) {
         rc = cdl_mts_error(c, doc.root.line, "the document element is <%s>, not <scene>", doc.root.name);
     } else {
@@ -403,8 +412,10 @@ static int read_file(cdl_mts_ctx *c, const char *path, int line)
             cdl_mts_warn(c, doc.root.line, "scene version \"%s\": read as Mitsuba 3", ver);
         for (int i = 0; i < doc.root.nkids && !rc; i++)
             rc = element(c, &doc.root.kids[i]);
+        for (int i = 0; i < doc.root.nkids && !rc; i++)
+            unreferenced_area(c, &doc.root.kids[i]);
     }
-    c->depth--;
+    c->roots[--c->depth] = NULL;
     c->file = outer;
     cdl_xml_free(&doc);
     return rc;

@@ -227,6 +227,9 @@ int cdl_mts_child_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int strict, int32_t *mat
             if (rc)
                 return rc;
             const cdl_mts_id *d = id ? cdl_mts_find_id(c, id) : NULL;
+            const cdl_xml_node *decl = id && (!d || d->kind == CDL_MTS_OTHER) ? cdl_mts_find_decl(c, id) : NULL;
+            if (decl && strcmp(decl->name, "bsdf"))
+                continue; /* an emitter or a medium: the shape's business */
             if (strict && !d)
                 return cdl_mts_error(c, k->line, "<ref id=\"%s\"> is not declared before", id ? id : "");
             if (strict && d->kind != CDL_MTS_BSDF)

@@ -239,6 +239,41 @@ static int check_attrs(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, int32_
     return 0;
 }
 
+/* A <ref> in a shape to something other than its bsdf: a top-level area
+ * emitter (Mitsuba 3 may declare one apart, before or after, and refer to
+ * it) is read here; a reference to an element candela skips (a medium) is
+ * skipped with a warning, as that element was. */
+static int shape_ref(cdl_mts_ctx *c, cdl_xml_node *k, int32_t *emit)
+{
+    int rc = 0;
+    const char *raw = cdl_mts_attr(c, k, "id", &rc);
+    if (rc || !raw)
+        return rc;
+    char id[256];
+    snprintf(id, sizeof id, "%s", raw);
+    const cdl_mts_id *d = cdl_mts_find_id(c, id);
+    cdl_xml_node *decl = d && d->kind != CDL_MTS_OTHER ? NULL : cdl_mts_find_decl(c, id);
+    if (!decl || !strcmp(decl->name, "bsdf"))
+        return 0; /* the shape's bsdf, or an undeclared id shape_bsdf reports */
+    k->used = 1;
+    if (strcmp(decl->name, "emitter")) {
+        cdl_mts_warn(c, k->line, "<ref id=\"%s\"> names a <%s>, which is not supported (ignored)", id, decl->name);
+        return 0;
+    }
+    if (*emit >= 0)
+        return cdl_mts_error(c, k->line, "a shape has one area emitter");
+    if (c->in_group) {
+        cdl_mts_warn(c, k->line, "an emitter on a shape in a shapegroup is not instanced: the shape does not emit");
+        return 0;
+    }
+    if (!d) { /* marks it referred to */
+        cdl_mts_id v = {id, CDL_MTS_OTHER, -1, -1, cdl_v3(0, 0, 0)};
+        if ((rc = cdl_mts_add_id(c, decl, &v)))
+            return rc;
+    }
+    return cdl_mts_area(c, decl, emit);
+}
+
 /* The shape's surface: a nested <bsdf>, a <ref> to one, or Mitsuba's default. */
 static int shape_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
 {
@@ -285,6 +320,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
                 continue;
             }
             rc = cdl_mts_area(c, &n->kids[i], &emit);
+        } else if (!strcmp(n->kids[i].name, "ref")) {
+            rc = shape_ref(c, &n->kids[i], &emit);
         }
     if (rc)
         return rc;

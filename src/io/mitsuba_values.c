@@ -168,7 +168,10 @@ int cdl_mts_color_node(cdl_mts_ctx *c, cdl_xml_node *p, cdl_vec3 *out)
                        : cdl_v3((float)x[0], (float)x[1], (float)x[2]);
     } else if (!strcmp(p->name, "spectrum")) {
         if (strchr(v, ':')) { /* wavelength:value pairs through the CIE observer */
-            double lam[64], val[64];
+            /* Mitsuba sets no limit; tabulated data at 1 nm steps over
+             * 360-830 nm has 471 entries */
+            enum { MAX_LAMBDA = 1024 };
+            double lam[MAX_LAMBDA], val[MAX_LAMBDA];
             int m = 0;
             for (const char *q = v; *q;) {
                 char *end;
@@ -180,8 +183,9 @@ int cdl_mts_color_node(cdl_mts_ctx *c, cdl_xml_node *p, cdl_vec3 *out)
                 double y = strtod(q, &end);
                 if (end == q || !isfinite(y))
                     return cdl_mts_error(c, p->line, "<spectrum> \"%s\" is not a list of wavelength:value", v);
-                if (m == 64)
-                    return cdl_mts_error(c, p->line, "<spectrum> \"%s\": more than 64 wavelengths", v);
+                if (m == MAX_LAMBDA)
+                    return cdl_mts_error(c, p->line, "<spectrum> \"%.40s...\": more than %d wavelengths", v,
+                                         (int)MAX_LAMBDA);
                 lam[m] = l;
                 val[m++] = y;
                 q = end;
@@ -333,7 +337,7 @@ static int transform_op(cdl_mts_ctx *c, cdl_xml_node *op, cdl_mat4 *m)
         } else {
             return cdl_mts_error(c, op->line, "<matrix> has %d numbers; give 16 (or 9), row by row", k);
         }
-    } else if (!strcmp(op->name, "lookat")) {
+    } else if (!strcmp(op->name, "lookat") || !strcmp(op->name, "lookAt")) { /* lookAt: Mitsuba 0.3 and before */
         static const double yup[3] = {0, 1, 0};
         double o[3], t[3], up[3];
         if ((rc = triple(c, op, "origin", 1, NULL, o)) || (rc = triple(c, op, "target", 1, NULL, t)) ||

@@ -123,14 +123,14 @@ int cdl_pbrt_light(cdl_pbrt_ctx *c, const char *type)
         return cdl_pbrt_scene_rc(c, cdl_scene_add_distant_light(c->s, D, v, err));
     double cone, cdelta;
     if ((rc = cdl_pbrt_get_float(ps, "coneangle", 30.0, &cone, err)) ||
-        (rc = cdl_pbrt_get_float(ps, "conedelta", 5.0, &cdelta, err)))
+        (rc = cdl_pbrt_get_float(ps, "conedeltaangle", 5.0, &cdelta, err)))
         return rc;
     if (!(cone > 0.0 && cone <= 180.0))
         return cdl_pbrt_error(c, c->line, "spot coneangle %g must be in (0, 180] degrees", cone);
     if (!(cdelta >= 0.0))
-        return cdl_pbrt_error(c, c->line, "spot conedelta %g must not be negative", cdelta);
+        return cdl_pbrt_error(c, c->line, "spot conedeltaangle %g must not be negative", cdelta);
     if (cdelta > cone) { /* pbrt renders it: the falloff then starts at the axis */
-        cdl_pbrt_warn(c, c->line, "spot conedelta %g exceeds coneangle %g: clamped to it", cdelta, cone);
+        cdl_pbrt_warn(c, c->line, "spot conedeltaangle %g exceeds coneangle %g: clamped to it", cdelta, cone);
         cdelta = cone;
     }
     return cdl_pbrt_scene_rc(c, cdl_scene_add_spot_light(c->s, P, D, v, (float)cone, (float)cdelta, err));

@@ -255,9 +255,12 @@ static int make(cdl_pbrt_ctx *c, const char *type, cdl_material *m)
     } else if (!strcmp(type, "mirror")) {
         *m = cdl_material_default(CDL_MAT_MIRROR);
         rc = mat_spectrum(c, "Kr", cdl_v3(0.9f, 0.9f, 0.9f), &m->ks, NULL, NULL);
-    } else if (!strcmp(type, "glass") || !strcmp(type, "dielectric")) {
-        int v4 = type[0] == 'd';
+    } else if (!strcmp(type, "glass") || !strcmp(type, "dielectric") || !strcmp(type, "thindielectric")) {
+        int v4 = type[0] != 'g';
         *m = cdl_material_default(CDL_MAT_DIELECTRIC);
+        if (type[0] == 't') /* as the Mitsuba reader takes Mitsuba's thindielectric */
+            cdl_pbrt_warn(c, c->line, "material \"thindielectric\" approximated by a dielectric (light refracts "
+                                      "where pbrt's passes straight through)");
         if ((rc = eta_param(c, &eta)) || (rc = roughness(c, 0.0, v4, m, &smooth)))
             return rc;
         if (!v4 && ((rc = mat_spectrum(c, "Kr", one, &m->ks, NULL, NULL)) ||
