@@ -64,7 +64,7 @@ static void referenced_area_emitters(void)
     int rc = load("area.xml",
                   "<scene version=\"3.0.0\">\n"
                   "<emitter type=\"area\" id=\"before\"><rgb name=\"radiance\" value=\"1, 2, 3\"/></emitter>\n"
-                  "<bsdf type=\"diffuse\" id=\"white\"/>\n" RECT("<ref id=\"white\"/><ref id=\"before\"/>")
+                  "<bsdf type=\"twosided\" id=\"white\"><bsdf type=\"diffuse\"/></bsdf>\n" RECT("<ref id=\"white\"/><ref id=\"before\"/>")
                       RECT("<ref id=\"after\"/><ref id=\"white\"/>")
                   "<emitter type=\"area\" id=\"after\"><rgb name=\"radiance\" value=\"4, 5, 6\"/></emitter>\n"
                   "</scene>\n",
@@ -89,6 +89,30 @@ static void referenced_area_emitters(void)
               &s, &line);
     CHECK(!rc && warnings == 1 && s.nlights == 1, "an area emitter no shape refers to warns at its line (%d)",
           warnings);
+    if (!rc)
+        cdl_scene_free(&s);
+}
+
+/* Mitsuba's opaque bsdfs are one-sided unless wrapped in twosided;
+ * candela's reflect on both sides: said once per file, at the first
+ * unwrapped bsdf's line (dielectrics are two-sided in both). */
+static void one_sided_bsdfs(void)
+{
+    cdl_scene s;
+    int line = 3;
+    static const char text[] =
+                  "<scene version=\"3.0.0\">\n"
+                  "<bsdf type=\"twosided\" id=\"a\"><bsdf type=\"diffuse\"/></bsdf><bsdf type=\"dielectric\" id=\"g\"/>\n"
+                  "<bsdf type=\"roughconductor\" id=\"b\"/>\n"
+                  "<bsdf type=\"diffuse\" id=\"c\"/>\n" RECT("<ref id=\"b\"/>")
+                  "<emitter type=\"point\"/>\n</scene>\n";
+    int rc = load("sides.xml", text, &s, NULL);
+    int all = warnings;
+    if (!rc)
+        cdl_scene_free(&s);
+    rc = load("sides.xml", text, &s, &line);
+    CHECK(!rc && all == 1 && warnings == 1, "an opaque bsdf outside twosided warns once, at the first one's line "
+                                           "(%d warnings, %d at line 3)", all, warnings);
     if (!rc)
         cdl_scene_free(&s);
 }
@@ -180,6 +204,7 @@ int main(void)
     }
     referenced_area_emitters();
     references_to_skipped_elements();
+    one_sided_bsdfs();
     lookat_spelling();
     long_spectra();
     char cmd[300];

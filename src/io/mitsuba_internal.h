@@ -55,6 +55,8 @@ typedef struct cdl_mts_ctx {
     int saw_sensor;
     uint32_t nshapes;
     int in_group;           /* reading the shapes of a shapegroup */
+    int in_twosided;        /* reading the bsdf a twosided wrapper holds */
+    int said_one_sided;     /* the one-sided approximation was warned of (once per file) */
     int legacy;             /* the main file's version is 0.x: Mitsuba 0.6's conventions where they differ */
     float *sky_rgb;         /* the daylight emitters' image, added as the environment light at the end */
     int sky_w, sky_h, sky_line;

@@ -532,7 +532,10 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         return cdl_mts_perturbed_bsdf(c, n, type, mat);
     for (size_t i = 0; i < sizeof wrap / sizeof wrap[0]; i++)
         if (!strcmp(type, wrap[i])) {
-            if ((rc = cdl_mts_child_bsdf(c, n, 0, mat, &found)))
+            c->in_twosided += i == 0;
+            rc = cdl_mts_child_bsdf(c, n, 0, mat, &found);
+            c->in_twosided -= i == 0;
+            if (rc)
                 return rc;
             if (!found)
                 return cdl_mts_error(c, n->line, "bsdf \"%s\" needs a nested <bsdf> or <ref>", type);
@@ -623,6 +626,15 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_COATED || m.type == CDL_MAT_ROUGH_COATED ||
         m.type == CDL_MAT_PHONG)
         m.kd = at_most_one(c, n->line, "diffuse reflectance", m.kd);
+    if (!c->in_twosided && !c->said_one_sided && m.type != CDL_MAT_DIELECTRIC && m.type != CDL_MAT_ROUGH_DIELECTRIC &&
+        strcmp(type, "principledthin")) {
+        /* Mitsuba's opaque bsdfs reflect on the front side only; candela's
+         * are two-sided (the difference shows only where a back face is seen) */
+        cdl_mts_warn(c, n->line,
+                     "bsdf \"%s\" outside a twosided wrapper: Mitsuba renders its back face black, candela "
+                     "reflects on both sides (said once per file)", type);
+        c->said_one_sided = 1;
+    }
     const char *id = cdl_xml_attr_get(n, "id");
     snprintf(m.name, sizeof m.name, "%.63s", id ? id : type);
     cdl_mts_warn_unused(c, n, type);
