@@ -561,10 +561,48 @@ static void test_init(void)
     check(orth < 1e-6, "bsdf_init shading frame orthonormal: max |dot| %.2e (< 1e-6)", orth);
 }
 
+/* A one-sided opaque bsdf (Mitsuba's, outside twosided) equals the
+ * two-sided one seen from the front and is black from the back: eval, pdf
+ * and sampling, for diffuse, phong and a rough conductor. */
+static void test_one_sided(void)
+{
+    static const cdl_mat_type types[] = {CDL_MAT_DIFFUSE, CDL_MAT_PHONG, CDL_MAT_CONDUCTOR};
+    dvec ngd = geo_normal();
+    dframe gf = dframe_from(ngd);
+    int bad = 0, front_ok = 0;
+    for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
+        cdl_material m = make_material(types[t], 0.5f, 0.4f, 10.0f, 1.0f);
+        m.alpha_x = m.alpha_y = 0.3f;
+        cdl_bsdf two, one;
+        cdl_bsdf_init(&two, &m, m.kd, to_f(ngd), to_f(ngd));
+        m.one_sided = 1;
+        cdl_bsdf_init(&one, &m, m.kd, to_f(ngd), to_f(ngd));
+        for (int side = 0; side < 2; side++) {
+            double off = side ? 180.0 : 0.0; /* polar angles beyond 90: the back */
+            cdl_vec3 wo = to_f(polar(&gf, (off ? 180.0 - 40.0 : 40.0) * DEG, 20.0 * DEG));
+            cdl_vec3 wi = to_f(polar(&gf, (off ? 180.0 - 30.0 : 30.0) * DEG, 200.0 * DEG));
+            cdl_vec3 f1 = cdl_bsdf_eval(&one, wo, wi, 0), f2 = cdl_bsdf_eval(&two, wo, wi, 0);
+            float p1 = cdl_bsdf_pdf(&one, wo, wi), p2 = cdl_bsdf_pdf(&two, wo, wi), pe;
+            cdl_vec3 fe = cdl_bsdf_eval_pdf(&one, wo, wi, 1, &pe);
+            cdl_scatter sc;
+            int s1 = cdl_bsdf_sample(&one, wo, 0.3f, 0.4f, 0.6f, 0, &sc);
+            if (!side) {
+                bad += f1.x != f2.x || p1 != p2 || !(f2.x > 0.0f) || fe.x != f1.x || pe != p1 || !s1;
+                front_ok += f2.x > 0.0f;
+            } else {
+                bad += f1.x != 0.0f || p1 != 0.0f || fe.x != 0.0f || pe != 0.0f || s1 || !(f2.x > 0.0f);
+            }
+        }
+    }
+    check(bad == 0 && front_ok == 3, "one-sided opaque bsdfs: the two-sided values in front, black behind "
+                                     "(%d mismatches)", bad);
+}
+
 int main(void)
 {
     test_gamma(1);
     test_init();
+    test_one_sided();
 
     static const opaque_case cases[] = {
         {"lambert kd=0.8", CDL_MAT_DIFFUSE, 0.8f, 0.0f, 0.0f, 0.0f},

@@ -265,6 +265,8 @@ static cdl_vec3 radiance(pm_state *st, scratch *w, cdl_vec3 o, cdl_vec3 d, cdl_s
             if (cdl_bsdf_is_delta(&bg))
                 continue; /* specular then x: the caustic map's paths */
             cdl_vec3 wg = cdl_neg(sc.wi);
+            if (bg.one_sided && cdl_dot(wg, sg.ng) <= 0.0f)
+                continue; /* the back of a one-sided surface reflects nothing */
             int found = 0;
             /* the points hold photons of up to maxdepth - 1 bounces: all a
              * gather from the first vertex may use, more after a mirror

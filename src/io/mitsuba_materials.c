@@ -250,6 +250,7 @@ int cdl_mts_default_material(cdl_mts_ctx *c, int32_t *mat)
     if (c->default_mat < 0) {
         cdl_material m = cdl_material_default(CDL_MAT_DIFFUSE);
         uint32_t id;
+        m.one_sided = 1; /* Mitsuba's default bsdf, a diffuse one */
         snprintf(m.name, sizeof m.name, "mitsuba-default");
         int rc = cdl_scene_add_material(c->s, &m, &id, c->err);
         if (rc)
@@ -501,6 +502,7 @@ static int blend(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         cdl_material d = cdl_material_default(CDL_MAT_DIFFUSE);
         d.kd = cdl_v3(1.0f, 1.0f, 1.0f);
         d.hit_kd = 1;
+        d.one_sided = a->one_sided && b->one_sided;
         snprintf(d.name, sizeof d.name, "blend-of-diffuse");
         if ((rc = cdl_mts_scene_rc(c, n->line, cdl_scene_add_material(c->s, &d, &idx, c->err))))
             return rc;
@@ -513,6 +515,27 @@ static int blend(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
         return rc;
     *mat = (int32_t)idx;
     return 0;
+}
+
+/* twosided: the nested bsdf on both sides. One made inside is two-sided
+ * already; one referred to (declared one-sided) is copied. A second
+ * nested bsdf (Mitsuba 3: a different back side) is not rendered. */
+static int two_sided(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
+{
+    int nb = 0;
+    for (int k = 0; k < n->nkids; k++)
+        nb += !strcmp(n->kids[k].name, "bsdf") || !strcmp(n->kids[k].name, "ref");
+    if (nb > 1)
+        cdl_mts_warn(c, n->line, "bsdf \"twosided\" with a second bsdf for the back side: the first is used on both");
+    if (*mat < 0 || !c->s->mats[*mat].one_sided)
+        return 0;
+    cdl_material m = c->s->mats[*mat];
+    m.one_sided = 0;
+    uint32_t idx;
+    int rc = cdl_mts_add_material(c, n->line, &m, &idx);
+    if (!rc)
+        *mat = (int32_t)idx;
+    return rc;
 }
 
 int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
@@ -539,6 +562,8 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
                 return rc;
             if (!found)
                 return cdl_mts_error(c, n->line, "bsdf \"%s\" needs a nested <bsdf> or <ref>", type);
+            if (i == 0 && (rc = two_sided(c, n, mat)))
+                return rc;
             if (i > 0) {
                 cdl_mts_warn(c, n->line, "bsdf \"%s\": only its (first) nested bsdf is rendered", type);
                 for (int k = 0; k < n->nkids; k++)
@@ -626,10 +651,9 @@ int cdl_mts_bsdf(cdl_mts_ctx *c, cdl_xml_node *n, int32_t *mat)
     if (m.type == CDL_MAT_DIFFUSE || m.type == CDL_MAT_COATED || m.type == CDL_MAT_ROUGH_COATED ||
         m.type == CDL_MAT_PHONG)
         m.kd = at_most_one(c, n->line, "diffuse reflectance", m.kd);
-    if (!c->in_twosided && !c->said_one_sided && m.type != CDL_MAT_DIELECTRIC && m.type != CDL_MAT_ROUGH_DIELECTRIC &&
-        strcmp(type, "principledthin")) {
-        /* Mitsuba's opaque bsdfs reflect on the front side only; candela's
-         * are two-sided (the difference shows only where a back face is seen) */
+    /* Mitsuba's opaque bsdfs reflect on the front side only */
+    m.one_sided = !c->in_twosided;
+    if (!c->in_twosided && !c->said_one_sided && m.type == CDL_MAT_PRINCIPLED) {
         cdl_mts_warn(c, n->line,
                      "bsdf \"%s\" outside a twosided wrapper: Mitsuba renders its back face black, candela "
                      "reflects on both sides (said once per file)", type);

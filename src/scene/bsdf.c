@@ -7,6 +7,8 @@
 #include "scene/microfacet_mts.h"
 #include "scene/plastic.h"
 
+static int is_opaque(const cdl_bsdf *b);
+
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
                    cdl_vec3 ns, cdl_vec3 ng)
 {
@@ -38,6 +40,7 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->frame = cdl_frame_from(ns);
     b->nb = ns;
     b->perturbed = 0;
+    b->one_sided = m->one_sided && is_opaque(b);
     b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PRINCIPLED) /* constants; cdl_scene_bsdf adds textures */
         cdl_principled_at_init(&b->pr, &m->pr, NULL, 0.0f, 0.0f);
@@ -84,7 +87,7 @@ static int opaque_local(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi,
     float go = cdl_dot(wo, b->ng), gi = cdl_dot(wi, b->ng);
     /* within 1e-6 of the plane the side is rounding: two points of one
      * sheet of zero thickness, one on each side, must not connect */
-    if (go * gi <= 0.0f || fabsf(go) < 1e-6f || fabsf(gi) < 1e-6f)
+    if (go * gi <= 0.0f || fabsf(go) < 1e-6f || fabsf(gi) < 1e-6f || (b->one_sided && go < 0.0f))
         return 0;
     *lo = cdl_to_local(&b->frame, wo);
     *li = cdl_to_local(&b->frame, wi);
@@ -257,7 +260,7 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
                          float u2, cdl_scatter *s)
 {
     float go = cdl_dot(wo, b->ng);
-    if (fabsf(go) < 1e-6f)
+    if (fabsf(go) < 1e-6f || (b->one_sided && go < 0.0f))
         return 0;
     cdl_vec3 lo = cdl_to_local(&b->frame, wo);
     float side = go < 0.0f ? -1.0f : 1.0f;

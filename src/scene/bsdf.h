@@ -27,6 +27,7 @@ typedef struct cdl_bsdf {
     cdl_vec3 ng;     /* geometric normal, same side as the CCW front face */
     cdl_vec3 nb;     /* shading normal before a bump/normal map (frame.n without) */
     int perturbed;   /* frame.n differs from nb: Mitsuba's checks and shadowing term apply */
+    int one_sided;   /* opaque: black unless wo and wi lie on the front (ng's) side */
 } cdl_bsdf;
 
 typedef struct cdl_scatter {

@@ -117,6 +117,8 @@ typedef struct cdl_material {
     int blend[2], blend_tex, blend_as;
     float blend_w;
     int hit_kd;        /* kd times the surface's kdh (set at the hit), not the kd texture */
+    int one_sided;     /* opaque: reflects on the front (CCW) side only, black behind (Mitsuba's
+                        * bsdfs outside a twosided wrapper); else on both sides */
     char name[64];
 } cdl_material;
 

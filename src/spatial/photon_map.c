@@ -151,7 +151,7 @@ cdl_vec3 cdl_pmap_radiance(const cdl_photon_map *m, const cdl_pm_query *q, cdl_v
     vis_origin vo = {x, nx, wo, x, CDL_VIS_LIFT * sqrtf(r2), 0};
     /* Lambertian: f = kd / pi wherever the BSDF reflects, which only the
      * signs of wi decide (no normalization, no general evaluation) */
-    int lambert = b->type == CDL_MAT_DIFFUSE;
+    int lambert = b->type == CDL_MAT_DIFFUSE && !b->one_sided;
     float go = cdl_dot(wo, b->ng), so = cdl_dot(wo, b->frame.n) * (go < 0.0f ? -1.0f : 1.0f);
     cdl_vec3 fd = cdl_scale(b->kd, (float)CDL_INV_PI), zero = cdl_v3(0.0f, 0.0f, 0.0f);
     if (lambert && !q->vis.fn) {

@@ -28,8 +28,8 @@ int cdl_find_visible(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, int maxdepth, c
             v->L = cdl_add(v->L, cdl_mul(v->beta, cdl_light_Le_uv(&s->lights[v->sf.light], v->sf.ng, v->wo, v->sf.u, v->sf.v)));
         if (depth >= maxdepth)
             return 0;
-        if (!cdl_bsdf_is_delta(&v->b))
-            return 1;
+        if (!cdl_bsdf_is_delta(&v->b)) /* the back of a one-sided surface reflects nothing */
+            return !(v->b.one_sided && cdl_dot(v->wo, v->sf.ng) <= 0.0f);
         cdl_scatter sc;
         float u0 = cdl_sampler_1d(smp), u1, u2;
         cdl_sampler_2d(smp, &u1, &u2);
