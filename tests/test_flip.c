@@ -9,18 +9,8 @@
 
 #include "candela/candela.h"
 #include "film/flip.h"
+#include "test_util.h"
 
-static int failures;
-
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        int ok_ = (cond);                                                                          \
-        printf("%s: ", ok_ ? "ok  " : "FAIL");                                                     \
-        printf(__VA_ARGS__);                                                                       \
-        printf("\n");                                                                              \
-        if (!ok_)                                                                                  \
-            failures++;                                                                            \
-    } while (0)
 
 static cdl_image make(int w, int h)
 {
@@ -312,6 +302,6 @@ int main(void)
     test_filters();
     test_exposures();
     test_api();
-    printf("%d failed\n", failures);
-    return failures != 0;
+    printf("%d failed\n", test_failures);
+    return test_failures != 0;
 }

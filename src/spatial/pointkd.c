@@ -285,6 +285,18 @@ typedef struct collect {
     float *d2;
 } collect;
 
+/* Point p at squared distance d kept if within r2; -1 when c is full. */
+static int keep(collect *c, uint32_t p, float d, float r2)
+{
+    if (d > r2)
+        return 0;
+    if (c->n == c->cap)
+        return -1;
+    c->idx[c->n] = p;
+    c->d2[c->n++] = d;
+    return 0;
+}
+
 static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 q, float r2, collect *c)
 {
     while (lo < hi) {
@@ -292,13 +304,8 @@ static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 
             if (c->n + (hi - lo) > c->cap) { /* near full: one at a time */
                 for (uint32_t i = lo; i < hi; i++) {
                     uint32_t p = t->identity ? i : t->idx[i];
-                    float d = dist2(t, p, q);
-                    if (d <= r2) {
-                        if (c->n == c->cap)
-                            return -1;
-                        c->idx[c->n] = p;
-                        c->d2[c->n++] = d;
-                    }
+                    if (keep(c, p, dist2(t, p, q), r2))
+                        return -1;
                 }
                 return 0;
             }
@@ -313,13 +320,8 @@ static int collect_ball(const cdl_kdtree *t, uint32_t lo, uint32_t hi, cdl_vec3 
             return 0;
         }
         uint32_t mid = lo + (hi - lo) / 2, p = t->identity ? mid : t->idx[mid];
-        float d = dist2(t, p, q);
-        if (d <= r2) {
-            if (c->n == c->cap)
-                return -1;
-            c->idx[c->n] = p;
-            c->d2[c->n++] = d;
-        }
+        if (keep(c, p, dist2(t, p, q), r2))
+            return -1;
         int a = t->axis[mid];
         float delta = (a == 0 ? q.x : a == 1 ? q.y : q.z) - coord(t, p, a);
         int go_left = delta <= 0.0f || delta * delta <= r2;
