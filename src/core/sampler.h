@@ -17,6 +17,7 @@ typedef enum cdl_sampler_kind { CDL_SAMPLER_SOBOL, CDL_SAMPLER_INDEPENDENT } cdl
 typedef struct cdl_sampler {
     uint64_t key;   /* hash of (seed, pixel or path) */
     uint32_t index; /* sample (pass) number */
+    uint32_t rindex; /* index with its bits reversed (every draw scrambles it) */
     uint32_t dim;
     uint32_t cheap; /* draws of cdl_sampler_cheap so far */
     cdl_sampler_kind kind;
@@ -84,6 +85,7 @@ static inline void cdl_sampler_start(cdl_sampler *s, cdl_sampler_kind kind, uint
     s->kind = kind;
     s->key = cdl_mix64(seed * 0x9e3779b97f4a7c15ULL ^ cdl_mix64(stream));
     s->index = index;
+    s->rindex = cdl_reverse_bits(index);
     s->dim = 0;
     s->cheap = 0;
     s->rng.state = s->rng.inc = 0;
@@ -99,7 +101,7 @@ static inline uint32_t cdl_sampler_next(cdl_sampler *s, uint32_t *s1, uint32_t *
     s->dim++;
     *s1 = (uint32_t)(h >> 32);
     *s2 = ((uint32_t)h ^ 0x9e3779b9u) * 0x85ebca6bu ^ *s1;
-    return cdl_reverse_bits(cdl_lk_hash(cdl_reverse_bits(s->index), (uint32_t)h));
+    return cdl_reverse_bits(cdl_lk_hash(s->rindex, (uint32_t)h));
 }
 
 static inline float cdl_sampler_1d(cdl_sampler *s)
