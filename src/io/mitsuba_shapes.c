@@ -1,6 +1,6 @@
 /* Mitsuba shapes: meshes from OBJ, PLY and serialized files, the built-in
- * rectangle, cube, disk, sphere and cylinder, each with its bsdf and area
- * emitter.
+ * rectangle, cube, disk, sphere and cylinder, and the sdfgrid (polygonized),
+ * each with its bsdf and area emitter (not the sdfgrid's, as in Mitsuba).
  * Orientation is Mitsuba's: a triangle faces its shading normals when the
  * mesh has them, else its counter-clockwise normal after the transform
  * (Mitsuba does not flip faces under mirroring transforms, unlike pbrt);
@@ -18,9 +18,20 @@
 #include "io/obj_loader.h"
 #include "io/ply.h"
 #include "io/serialized.h"
+#include "io/vol.h"
+#include "scene/sdfgrid.h"
 
 #define PI 3.14159265358979323846
 #define DISK_SEGMENTS 128
+/* An sdfgrid's samples and triangles: a fuzzer's input (ASan, 20 s) must
+ * neither allocate nor polygonize for long. */
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+#define SDF_MAX_SAMPLES (1u << 15)
+#define SDF_MAX_TRIS (1u << 16)
+#else
+#define SDF_MAX_SAMPLES (1u << 27)
+#define SDF_MAX_TRIS (1u << 28)
+#endif
 
 /* Mitsuba 3's rectangle: [-1, 1]^2 at z = 0, facing +z. */
 static int rectangle(cdl_mts_ctx *c, int line, cdl_mesh *m)
@@ -160,6 +171,38 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
     return 0;
 }
 
+/* Mitsuba 3's sdfgrid: a .vol file of signed distances over [0, 1]^3,
+ * polygonized (scene/sdfgrid.h) with Mitsuba's shading normals; no uv. */
+static int sdfgrid(cdl_mts_ctx *c, cdl_xml_node *n, cdl_mesh *m)
+{
+    char fn[1024], path[1024], how[32];
+    int rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn);
+    if (rc || (rc = cdl_mts_string(c, n, "normals", "smooth", how, sizeof how)))
+        return rc;
+    if (strcmp(how, "smooth") && strcmp(how, "analytic"))
+        return cdl_mts_error(c, n->line, "sdfgrid normals \"%s\": \"smooth\" or \"analytic\"", how);
+    if (!fn[0])
+        return cdl_mts_error(c, n->line, "shape \"sdfgrid\" needs a \"filename\" (a grid tensor is Python-only)");
+    if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
+        return rc;
+    cdl_vol vol;
+    if ((rc = cdl_vol_read(path, 1, 2, SDF_MAX_SAMPLES, &vol, c->err))) {
+        char msg[sizeof c->err->msg];
+        snprintf(msg, sizeof msg, "%s", c->err->msg);
+        return rc == CDL_ERR_INPUT ? cdl_mts_error(c, n->line, "sdfgrid \"%s\": %s", path, msg) : rc;
+    }
+    cdl_sdfgrid g = {{vol.res[0], vol.res[1], vol.res[2]}, vol.data};
+    int levels = cdl_sdfgrid_default_levels(&g);
+    rc = cdl_sdfgrid_polygonize(&g, levels, strcmp(how, "smooth") ? CDL_SDF_ANALYTIC : CDL_SDF_SMOOTH, SDF_MAX_TRIS,
+                                m, c->file, n->line, c->err);
+    cdl_vol_free(&vol);
+    if (!rc)
+        cdl_mts_warn(c, n->line, "sdfgrid %d x %d x %d polygonized at %d subdivisions per voxel (%u triangles); "
+                                 "Mitsuba intersects the trilinear surface exactly", g.n[0], g.n[1], g.n[2], levels,
+                     m->ntris);
+    return rc;
+}
+
 /* <shape type="shapegroup" id="...">: its shapes, in object space, become
  * a scene shape group that <shape type="instance"> places. */
 static int shapegroup(cdl_mts_ctx *c, cdl_xml_node *n)
@@ -292,7 +335,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         return shapegroup(c, n);
     if (!strcmp(type, "instance"))
         return instance(c, n);
-    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder"};
+    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder",
+                                         "sdfgrid"};
     size_t kind = 0;
     while (kind < sizeof known / sizeof known[0] && strcmp(type, known[kind]))
         kind++;
@@ -308,7 +352,9 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         (rc = shape_bsdf(c, n, &mat)))
         return rc;
     for (int i = 0; i < n->nkids && !rc; i++)
-        if (!strcmp(n->kids[i].name, "emitter")) {
+        if (!strcmp(n->kids[i].name, "emitter") && !strcmp(type, "sdfgrid")) {
+            return cdl_mts_error(c, n->kids[i].line, "an sdfgrid cannot be an area emitter (as in Mitsuba)");
+        } else if (!strcmp(n->kids[i].name, "emitter")) {
             if (emit >= 0)
                 return cdl_mts_error(c, n->kids[i].line, "a shape has one area emitter");
             if (c->in_group) { /* Mitsuba refuses these; pbrt-v4 drops them with a warning, as here */
@@ -373,6 +419,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         rc = cube(c, n->line, &mesh);
     else if (!strcmp(type, "disk"))
         rc = disk(c, n->line, &mesh);
+    else if (!strcmp(type, "sdfgrid"))
+        rc = sdfgrid(c, n, &mesh);
     else
         rc = cylinder(c, n, &mesh, &m);
     if (!rc) {
