@@ -155,7 +155,7 @@ int cdl_sdfgrid_default_levels(const cdl_sdfgrid *g)
 {
     int m = g->n[0] > g->n[1] ? g->n[0] : g->n[1];
     m = m > g->n[2] ? m : g->n[2];
-    int k = (256 + (m - 1) / 2) / (m - 1);
+    int k = (128 + (m - 1) / 2) / (m - 1);
     return k < 1 ? 1 : k > 8 ? 8 : k;
 }
 

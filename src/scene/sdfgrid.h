@@ -33,7 +33,7 @@ double cdl_sdfgrid_eval(const cdl_sdfgrid *g, const double p[3], double grad[3])
  * voxel holding p. A zero vector where every gradient vanishes. */
 void cdl_sdfgrid_normal(const cdl_sdfgrid *g, cdl_sdf_normals how, const double p[3], double out[3]);
 
-/* Subdivisions per voxel edge that put about 256 cells along the grid's
+/* Subdivisions per voxel edge that put about 128 cells along the grid's
  * longest axis (1 to 8). */
 int cdl_sdfgrid_default_levels(const cdl_sdfgrid *g);
 
