@@ -293,7 +293,7 @@ static int reads_uv(const cdl_scene *s, int32_t mat, int depth)
     if (mat < 0 || (uint32_t)mat >= s->nmats || depth > 16)
         return 0;
     const cdl_material *x = &s->mats[mat];
-    int t = x->kd_tex >= 0 || x->opacity_tex >= 0 || x->blend_tex >= 0 ||
+    int t = x->kd_tex >= 0 || (x->masked && x->opacity_tex >= 0) || x->blend_tex >= 0 ||
             (x->maps.on && (x->maps.alpha_tex[0] >= 0 || x->maps.alpha_tex[1] >= 0 || x->maps.bump_tex >= 0 ||
                             x->maps.normal_tex >= 0));
     for (int k = 0; x->type == CDL_MAT_PRINCIPLED && k < CDL_PR_NPARAMS; k++)
