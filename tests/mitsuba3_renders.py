@@ -56,14 +56,11 @@ PASSING = [
     "spot_light/test_spot_direct.xml",
     "texture_interp/test_texture_interp_direct.xml",
     "various_emitters/test_various_emitters_ptracer.xml",
+    "various_shapes/test_various_shapes_path.xml",
 ]
 
 # the measured reason each other scene fails (README, "Mitsuba 3 render tests")
-FAILING = {
-    "various_shapes/test_various_shapes_path.xml":
-        "the sdfgrid shape (a torus, instanced) is skipped (with the one-sided bsdfs 52885 of 691200 "
-        "values fail, 61738 before them)",
-}
+FAILING = {}
 
 # participating media: not candela's (every scene of the group but this one)
 SURFACE_ONLY_MEDIA = {"participating_media/test_surf_area_light_volpath.xml"}

@@ -1,6 +1,6 @@
 /* Mitsuba shapes: meshes from OBJ, PLY and serialized files, the built-in
- * rectangle, cube, disk, sphere and cylinder, each with its bsdf and area
- * emitter.
+ * rectangle, cube, disk, sphere and cylinder, and the sdfgrid (polygonized),
+ * each with its bsdf and area emitter (not the sdfgrid's, as in Mitsuba).
  * Orientation is Mitsuba's: a triangle faces its shading normals when the
  * mesh has them, else its counter-clockwise normal after the transform
  * (Mitsuba does not flip faces under mirroring transforms, unlike pbrt);
@@ -18,9 +18,20 @@
 #include "io/obj_loader.h"
 #include "io/ply.h"
 #include "io/serialized.h"
+#include "io/vol.h"
+#include "scene/sdfgrid.h"
 
 #define PI 3.14159265358979323846
 #define DISK_SEGMENTS 128
+/* An sdfgrid's samples and triangles: a fuzzer's input (ASan, 20 s) must
+ * neither allocate nor polygonize for long. */
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+#define SDF_MAX_SAMPLES (1u << 15)
+#define SDF_MAX_TRIS (1u << 16)
+#else
+#define SDF_MAX_SAMPLES (1u << 27)
+#define SDF_MAX_TRIS (1u << 28)
+#endif
 
 /* Mitsuba 3's rectangle: [-1, 1]^2 at z = 0, facing +z. */
 static int rectangle(cdl_mts_ctx *c, int line, cdl_mesh *m)
@@ -40,56 +51,63 @@ static int rectangle(cdl_mts_ctx *c, int line, cdl_mesh *m)
     return 0;
 }
 
-/* [-1, 1]^3, four vertices per face with the face's outward normal. */
+/* Mitsuba 3's cube: [-1, 1]^3, four vertices per face (faces -y, +y, +x,
+ * +z, -x, -z) with the face's outward normal and Mitsuba's uv corners (0,
+ * 1), (1, 1), (1, 0), (0, 0) in order, v flipped to candela's convention;
+ * its corner order decides where each face's uv square starts. */
 static int cube(cdl_mts_ctx *c, int line, cdl_mesh *m)
 {
+    /* per face: the normal axis and sign, then the corners as (+-1) pairs on the other two axes (a = axis + 1, b = axis + 2) */
+    static const signed char face[6][2] = {{1, -1}, {1, 1}, {0, 1}, {2, 1}, {0, -1}, {2, -1}};
+    static const signed char corner[6][4][3] = {
+        {{1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, {-1, -1, -1}}, {{1, 1, -1}, {-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}},
+        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},     {{1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, {-1, -1, 1}},
+        {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}}, {{1, 1, -1}, {1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}}};
+    static const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}; /* Mitsuba's (0,1) (1,1) (1,0) (0,0), v flipped */
     int rc = cdl_mesh_alloc(m, 24, 12, 1, 1, c->file, line, c->err);
     if (rc)
         return rc;
     for (int f = 0; f < 6; f++) {
-        int axis = f / 2;
-        float s = f % 2 ? 1.0f : -1.0f;
-        /* u, v axes with cross(u, v) = s * e_axis, so the corners run counter-clockwise seen from outside */
-        int ua = (axis + 1) % 3, va = (axis + 2) % 3;
         for (int k = 0; k < 4; k++) {
-            float cu = (k == 1 || k == 2) ? 1.0f : -1.0f, cv = k >= 2 ? 1.0f : -1.0f;
-            float *pp = m->pos + 3 * (4 * f + k), *nn = m->nrm + 3 * (4 * f + k);
-            pp[axis] = s;
-            pp[ua] = s > 0 ? cu : cv;
-            pp[va] = s > 0 ? cv : cu;
-            nn[0] = nn[1] = nn[2] = 0.0f;
-            nn[axis] = s;
-            m->uv[2 * (4 * f + k)] = 0.5f * (cu + 1.0f);
-            m->uv[2 * (4 * f + k) + 1] = 0.5f * (cv + 1.0f);
+            int v = 4 * f + k;
+            for (int a = 0; a < 3; a++) {
+                m->pos[3 * v + a] = corner[f][k][a];
+                m->nrm[3 * v + a] = a == face[f][0] ? face[f][1] : 0.0f;
+            }
+            m->uv[2 * v] = uv[k][0];
+            m->uv[2 * v + 1] = uv[k][1];
         }
         uint32_t b = (uint32_t)(4 * f), *t = m->idx + 6 * f;
-        t[0] = b, t[1] = b + 1, t[2] = b + 2, t[3] = b + 2, t[4] = b + 3, t[5] = b;
+        t[0] = b, t[1] = b + 1, t[2] = b + 2, t[3] = b + 3, t[4] = b, t[5] = b + 2;
     }
     return 0;
 }
 
-/* The unit disk at z = 0 facing +z, as a fan. */
+/* Mitsuba's disk: the unit disk at z = 0 facing +z with uv (r, phi / 2 pi),
+ * as a fan whose triangles each have their own centre vertex (at their
+ * middle angle) and a seam vertex at 2 pi, so phi interpolates right. */
 static int disk(cdl_mts_ctx *c, int line, cdl_mesh *m)
 {
     const int n = DISK_SEGMENTS;
-    int rc = cdl_mesh_alloc(m, (uint32_t)n + 1, (uint32_t)n, 1, 1, c->file, line, c->err);
+    int rc = cdl_mesh_alloc(m, (uint32_t)(2 * n + 1), (uint32_t)n, 1, 1, c->file, line, c->err);
     if (rc)
         return rc;
-    for (int i = 0; i <= n; i++) {
-        double a = 2.0 * PI * i / n;
+    for (int i = 0; i < 2 * n + 1; i++) {
+        int rim = i <= n;
+        double t = rim ? (double)i / n : (i - n - 0.5) / n; /* phi / 2 pi */
         float *pp = m->pos + 3 * i, *nn = m->nrm + 3 * i;
-        pp[0] = i == n ? 0.0f : (float)cos(a);
-        pp[1] = i == n ? 0.0f : (float)sin(a);
+        pp[0] = rim ? (float)cos(2.0 * PI * t) : 0.0f;
+        pp[1] = rim ? (float)sin(2.0 * PI * t) : 0.0f;
         pp[2] = 0.0f;
         nn[0] = nn[1] = 0.0f;
         nn[2] = 1.0f;
-        m->uv[2 * i] = i == n ? 0.0f : (float)i / (float)n; /* Mitsuba's (phi / 2 pi, r) */
-        m->uv[2 * i + 1] = i == n ? 0.0f : 1.0f;
+        m->uv[2 * i] = rim ? 1.0f : 0.0f;
+        m->uv[2 * i + 1] = (float)(1.0 - t);
     }
     for (int i = 0; i < n; i++) {
-        m->idx[3 * i] = (uint32_t)n;
+        m->idx[3 * i] = (uint32_t)(n + 1 + i);
         m->idx[3 * i + 1] = (uint32_t)i;
-        m->idx[3 * i + 2] = (uint32_t)((i + 1) % n);
+        m->idx[3 * i + 2] = (uint32_t)(i + 1);
     }
     return 0;
 }
@@ -116,7 +134,16 @@ static int cylinder(cdl_mts_ctx *c, cdl_xml_node *n, cdl_mesh *m, cdl_mat4 *xf)
         for (int j = 0; j < 4; j++)
             local.m[k][j] = col[j][k] * scale[j];
     *xf = cdl_mat4_mul(xf, &local);
-    return cdl_mesh_cylinder(m, 1.0, 0.0, 1.0, 2.0 * PI, DISK_SEGMENTS, c->file, n->line, c->err);
+    int rc2 = cdl_mesh_cylinder(m, 1.0, 0.0, 1.0, 2.0 * PI, DISK_SEGMENTS, c->file, n->line, c->err);
+    for (uint32_t i = 0; !rc2 && i < m->nverts; i++) /* Mitsuba's v is z: flipped to candela's convention */
+        m->uv[2 * i + 1] = 1.0f - m->uv[2 * i + 1];
+    return rc2;
+}
+
+static void flip_v(cdl_mesh *m)
+{
+    for (uint32_t i = 0; m->uv && i < m->nverts; i++)
+        m->uv[2 * i + 1] = 1.0f - m->uv[2 * i + 1];
 }
 
 static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh *m)
@@ -139,14 +166,16 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
             m->uv[2 * i + 1] = 1.0f - m->uv[2 * i + 1];
     } else if (!strcmp(type, "ply")) {
         rc = cdl_ply_read(path, m, c->err);
+        flip_v(m); /* Mitsuba reads a PLY's v as stored, candela's convention is flipped */
     } else {
         long index;
         if ((rc = cdl_mts_int(c, n, "shape_index", 0, &index)))
             return rc;
         if (index < 0 || index > 1000000000L)
             return cdl_mts_error(c, n->line, "shape_index %ld must be >= 0", index);
-        /* uvs as stored: Sponza's serialized meshes and its OBJ agree with them unflipped */
-        rc = cdl_serialized_read(path, (uint32_t)index, m, c->err);
+        /* Mitsuba reads a serialized mesh's v as stored, candela's convention is flipped */
+        if (!(rc = cdl_serialized_read(path, (uint32_t)index, m, c->err)))
+            flip_v(m);
     }
     if (rc)
         return rc;
@@ -158,6 +187,38 @@ static int mesh_file(cdl_mts_ctx *c, cdl_xml_node *n, const char *type, cdl_mesh
         m->nrm = NULL;
     }
     return 0;
+}
+
+/* Mitsuba 3's sdfgrid: a .vol file of signed distances over [0, 1]^3,
+ * polygonized (scene/sdfgrid.h) with Mitsuba's shading normals; no uv. */
+static int sdfgrid(cdl_mts_ctx *c, cdl_xml_node *n, cdl_mesh *m)
+{
+    char fn[1024], path[1024], how[32];
+    int rc = cdl_mts_string(c, n, "filename", NULL, fn, sizeof fn);
+    if (rc || (rc = cdl_mts_string(c, n, "normals", "smooth", how, sizeof how)))
+        return rc;
+    if (strcmp(how, "smooth") && strcmp(how, "analytic"))
+        return cdl_mts_error(c, n->line, "sdfgrid normals \"%s\": \"smooth\" or \"analytic\"", how);
+    if (!fn[0])
+        return cdl_mts_error(c, n->line, "shape \"sdfgrid\" needs a \"filename\" (a grid tensor is Python-only)");
+    if ((rc = cdl_mts_path(c, n->line, fn, path, sizeof path)))
+        return rc;
+    cdl_vol vol;
+    if ((rc = cdl_vol_read(path, 1, 2, SDF_MAX_SAMPLES, &vol, c->err))) {
+        char msg[sizeof c->err->msg];
+        snprintf(msg, sizeof msg, "%s", c->err->msg);
+        return rc == CDL_ERR_INPUT ? cdl_mts_error(c, n->line, "sdfgrid \"%s\": %s", path, msg) : rc;
+    }
+    cdl_sdfgrid g = {{vol.res[0], vol.res[1], vol.res[2]}, vol.data};
+    int levels = cdl_sdfgrid_default_levels(&g);
+    rc = cdl_sdfgrid_polygonize(&g, levels, strcmp(how, "smooth") ? CDL_SDF_ANALYTIC : CDL_SDF_SMOOTH, SDF_MAX_TRIS,
+                                m, c->file, n->line, c->err);
+    cdl_vol_free(&vol);
+    if (!rc)
+        cdl_mts_warn(c, n->line, "sdfgrid %d x %d x %d polygonized at %d subdivisions per voxel (%u triangles); "
+                                 "Mitsuba intersects the trilinear surface exactly", g.n[0], g.n[1], g.n[2], levels,
+                     m->ntris);
+    return rc;
 }
 
 /* <shape type="shapegroup" id="...">: its shapes, in object space, become
@@ -223,6 +284,23 @@ static int instance(cdl_mts_ctx *c, cdl_xml_node *n)
     cdl_mts_warn_unused(c, n, "shape \"instance\"");
     c->nshapes++;
     return cdl_mts_scene_rc(c, n->line, cdl_scene_add_instance(c->s, (uint32_t)g->tex, &m, c->err));
+}
+
+/* Whether material mat looks anything up by uv (or its frame by dp/du):
+ * candela's analytic spheres have neither in Mitsuba's parameterization. */
+static int reads_uv(const cdl_scene *s, int32_t mat, int depth)
+{
+    if (mat < 0 || (uint32_t)mat >= s->nmats || depth > 16)
+        return 0;
+    const cdl_material *x = &s->mats[mat];
+    int t = x->kd_tex >= 0 || (x->masked && x->opacity_tex >= 0) || x->blend_tex >= 0 ||
+            (x->maps.on && (x->maps.alpha_tex[0] >= 0 || x->maps.alpha_tex[1] >= 0 || x->maps.bump_tex >= 0 ||
+                            x->maps.normal_tex >= 0));
+    for (int k = 0; x->type == CDL_MAT_PRINCIPLED && k < CDL_PR_NPARAMS; k++)
+        t |= x->pr.tex[k] >= 0;
+    if (x->type == CDL_MAT_BLEND)
+        t |= reads_uv(s, x->blend[0], depth + 1) || reads_uv(s, x->blend[1], depth + 1);
+    return t;
 }
 
 /* A bsdf that reads a mesh attribute the shape lacks fails, as in Mitsuba. */
@@ -292,7 +370,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         return shapegroup(c, n);
     if (!strcmp(type, "instance"))
         return instance(c, n);
-    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder"};
+    static const char *const known[] = {"obj", "ply", "serialized", "rectangle", "cube", "disk", "sphere", "cylinder",
+                                         "sdfgrid"};
     size_t kind = 0;
     while (kind < sizeof known / sizeof known[0] && strcmp(type, known[kind]))
         kind++;
@@ -308,7 +387,9 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         (rc = shape_bsdf(c, n, &mat)))
         return rc;
     for (int i = 0; i < n->nkids && !rc; i++)
-        if (!strcmp(n->kids[i].name, "emitter")) {
+        if (!strcmp(n->kids[i].name, "emitter") && !strcmp(type, "sdfgrid")) {
+            return cdl_mts_error(c, n->kids[i].line, "an sdfgrid cannot be an area emitter (as in Mitsuba)");
+        } else if (!strcmp(n->kids[i].name, "emitter")) {
             if (emit >= 0)
                 return cdl_mts_error(c, n->kids[i].line, "a shape has one area emitter");
             if (c->in_group) { /* Mitsuba refuses these; pbrt-v4 drops them with a warning, as here */
@@ -350,7 +431,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
             return cdl_mts_error(c, n->line, "sphere radius %g must be > 0", r);
         cdl_mat4 t = cdl_mat4_translate(ctr.x, ctr.y, ctr.z), full = cdl_mat4_mul(&m, &t);
         cdl_mts_warn_unused(c, n, "shape \"sphere\"");
-        if (cdl_mat4_is_similarity(&full, 1e-4, &scale)) {
+        /* a textured sphere is a mesh: its uv are then Mitsuba's, and turn with it */
+        if (cdl_mat4_is_similarity(&full, 1e-4, &scale) && !reads_uv(c->s, mat, 0)) {
             cdl_vec3 w = cdl_mat4_point3(&full, cdl_v3(0, 0, 0));
             return cdl_mts_scene_rc(c, n->line, cdl_scene_add_sphere(c->s, w, (float)(r * scale), (uint32_t)mat, emit,
                                                                      flip, c->err));
@@ -373,6 +455,8 @@ int cdl_mts_shape(cdl_mts_ctx *c, cdl_xml_node *n)
         rc = cube(c, n->line, &mesh);
     else if (!strcmp(type, "disk"))
         rc = disk(c, n->line, &mesh);
+    else if (!strcmp(type, "sdfgrid"))
+        rc = sdfgrid(c, n, &mesh);
     else
         rc = cylinder(c, n, &mesh, &m);
     if (!rc) {
