@@ -290,6 +290,79 @@ static void traverse_spheres(const trav *v, uint32_t node)
     }
 }
 
+/* The wide tree's children whose spheres the frustum reaches, as a lane
+ * mask: sphere_reached on every lane at once. */
+static inline uint32_t wide_reached(const trav *v, const cdl_skd_wnode *w)
+{
+    const cdl_splat_ray *r = v->r;
+    const float ox = v->o[0], oy = v->o[1], oz = v->o[2], dx = v->d[0], dy = v->d[1], dz = v->d[2];
+    const float zmax = v->zmax, len = r->len, h0 = r->h0, dh = r->dh;
+    uint32_t ok[CDL_SKD_WIDTH];
+#pragma omp simd
+    for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++) {
+        float Dx = w->c[0][i] - ox, Dy = w->c[1][i] - oy, Dz = w->c[2][i] - oz, rad = w->c[3][i];
+        float z = Dx * dx + Dy * dy + Dz * dz, zr = z + rad;
+        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
+        float R = h0 + dh * (zr < len ? zr : len) + rad;
+        ok[i] = (zr >= 0.0f) & (z - rad <= zmax) & (ex * ex + ey * ey + ez * ez <= R * R);
+    }
+    uint32_t mask = 0;
+    for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++)
+        mask |= ok[i] << i;
+    return mask;
+}
+
+/* Whether a culling node prunes its subtree: every sample faces away from
+ * the ray (d . n / |n| >= C_max, without normalizing n). */
+static int culled(const trav *v, cdl_skd_node nd)
+{
+    float cmax = (float)(nd.b >> 16) / 65535.0f;
+    cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
+    float dv = cdl_dot(v->r->d, n);
+    return dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n);
+}
+
+#define WIDE_STACK 512
+
+/* The default traversal on the wide tree from entry e (its sphere
+ * tested), depth first with a stack: the leaves in the binary
+ * traversal's order. */
+static void traverse_wide(const trav *v, cdl_skd_went e)
+{
+    const cdl_skd *t = v->t;
+    cdl_skd_went stack[WIDE_STACK];
+    uint32_t sp = 0;
+    for (;;) {
+        v->cnt->nodes++;
+        if (e.n == CDL_SKD_WCULL) {
+            const cdl_skd_wcull *c = &t->wcull[e.ref];
+            if (!(v->cull && culled(v, t->nodes[c->node]))) {
+                e = c->next;
+                continue;
+            }
+        } else if (e.n == 0) {
+            const cdl_skd_wnode *w = &t->wide[e.ref];
+            uint32_t hit = wide_reached(v, w);
+            if (hit) {
+                uint32_t k = (uint32_t)__builtin_ctz(hit);
+                hit &= hit - 1;
+                while (hit) { /* the rest, last first: the lowest lane pops next */
+                    uint32_t j = 31u - (uint32_t)__builtin_clz(hit);
+                    hit &= ~(1u << j);
+                    stack[sp++] = (cdl_skd_went){w->ref[j], w->n[j]};
+                }
+                e = (cdl_skd_went){w->ref[k], w->n[k]};
+                continue;
+            }
+        } else if (e.n != CDL_SKD_WEMPTY) {
+            test_range(v, e.ref, e.ref + e.n);
+        }
+        if (!sp)
+            return;
+        e = stack[--sp];
+    }
+}
+
 /* Algorithm 1: node over the ray interval [t0, t1]. */
 static void traverse(const trav *v, uint32_t node, float t0, float t1)
 {
@@ -487,10 +560,13 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     }
     if (t0 > t1)
         return 0;
+    cdl_skd_went e = part != UINT32_MAX ? t->wpart[part] : t->wroot;
     if (v.slabs)
         traverse(&v, root, t0, t1);
-    else
+    else if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack */
         traverse_spheres(&v, root);
+    else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
+        traverse_wide(&v, e);
     return 0;
 }
 
