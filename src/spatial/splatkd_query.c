@@ -49,14 +49,7 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), _mm512_set1_ps(r->o.x));
     __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), _mm512_set1_ps(r->o.y));
     __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), _mm512_set1_ps(r->o.z));
-    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
-           nz = _mm512_loadu_ps(t->nrm[2] + b);
-    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
-    /* -|dn| for a two-sided sample */
-    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
     __m512 z = _mm512_fmadd_ps(Dz, dz, _mm512_fmadd_ps(Dy, dy, _mm512_mul_ps(Dx, dx)));
-    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
-                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
     /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray would
      * lose r^2 to cancellation */
     __m512 ex = _mm512_fnmadd_ps(z, dx, Dx), ey = _mm512_fnmadd_ps(z, dy, Dy), ez = _mm512_fnmadd_ps(z, dz, Dz);
@@ -64,8 +57,21 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     __m512 h = _mm512_fmadd_ps(_mm512_set1_ps(r->dh), _mm512_min_ps(z, len), _mm512_set1_ps(r->h0));
     __m512 h2 = _mm512_mul_ps(h, h), beyond = _mm512_sub_ps(z, len);
     __mmask16 ok = (__mmask16)(m >= 16 ? 0xffffu : (1u << m) - 1u);
-    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
+    /* inside the frustum (h only shrinks beyond the hit) and in front of
+     * the origin: most lanes a large range tests fail here, before the
+     * normals are loaded */
     ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
+    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
+    if (!ok)
+        return 0;
+    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
+           nz = _mm512_loadu_ps(t->nrm[2] + b);
+    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
+    /* -|dn| for a two-sided sample */
+    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
+    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
+                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
+    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
     /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
     __m512 non = _mm512_fmadd_ps(nz, _mm512_set1_ps(r->on.z),

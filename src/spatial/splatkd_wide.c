@@ -15,7 +15,7 @@
 
 /* A subtree of at most this many samples is tested without descending:
  * one 16-lane leaf test instead of its nodes' sphere tests. */
-#define RANGE_MAX 16u
+#define RANGE_MAX 96u
 #define PART_MARK (UINT32_MAX - 2) /* a part's root while the top is built */
 
 typedef struct wbuild {
