@@ -53,7 +53,7 @@ typedef struct cdl_skd_went {
     uint32_t ref, n;
 } cdl_skd_went;
 typedef struct cdl_skd_wcull {
-    uint32_t node;     /* the binary culling node */
+    float n[3], c2;    /* the culling node's mean normal (not unit) and C_max^2 |n|^2 */
     cdl_skd_went next; /* what follows when it does not cull */
 } cdl_skd_wcull;
 

@@ -303,6 +303,23 @@ static inline uint32_t wide_reached(const trav *v, const cdl_skd_wnode *w)
     const cdl_splat_ray *r = v->r;
     const float ox = v->o[0], oy = v->o[1], oz = v->o[2], dx = v->d[0], dy = v->d[1], dz = v->d[2];
     const float zmax = v->zmax, len = r->len, h0 = r->h0, dh = r->dh;
+#if defined(__AVX512F__) && defined(__AVX512VL__) && CDL_SKD_WIDTH == 8
+    /* the lanes' compares straight into a mask register */
+    __m256 Dx = _mm256_sub_ps(_mm256_loadu_ps(w->c[0]), _mm256_set1_ps(ox));
+    __m256 Dy = _mm256_sub_ps(_mm256_loadu_ps(w->c[1]), _mm256_set1_ps(oy));
+    __m256 Dz = _mm256_sub_ps(_mm256_loadu_ps(w->c[2]), _mm256_set1_ps(oz));
+    __m256 rad = _mm256_loadu_ps(w->c[3]), vdx = _mm256_set1_ps(dx), vdy = _mm256_set1_ps(dy), vdz = _mm256_set1_ps(dz);
+    __m256 z = _mm256_fmadd_ps(Dz, vdz, _mm256_fmadd_ps(Dy, vdy, _mm256_mul_ps(Dx, vdx)));
+    __m256 zr = _mm256_add_ps(z, rad);
+    __m256 ex = _mm256_fnmadd_ps(z, vdx, Dx), ey = _mm256_fnmadd_ps(z, vdy, Dy), ez = _mm256_fnmadd_ps(z, vdz, Dz);
+    __m256 e2 = _mm256_fmadd_ps(ez, ez, _mm256_fmadd_ps(ey, ey, _mm256_mul_ps(ex, ex)));
+    __m256 R = _mm256_add_ps(
+        _mm256_fmadd_ps(_mm256_set1_ps(dh), _mm256_min_ps(zr, _mm256_set1_ps(len)), _mm256_set1_ps(h0)), rad);
+    __mmask8 ok = _mm256_cmp_ps_mask(zr, _mm256_setzero_ps(), _CMP_GE_OQ);
+    ok = _mm256_mask_cmp_ps_mask(ok, _mm256_sub_ps(z, rad), _mm256_set1_ps(zmax), _CMP_LE_OQ);
+    ok = _mm256_mask_cmp_ps_mask(ok, e2, _mm256_mul_ps(R, R), _CMP_LE_OQ);
+    return ok;
+#else
     uint32_t ok[CDL_SKD_WIDTH];
 #pragma omp simd
     for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++) {
@@ -316,16 +333,15 @@ static inline uint32_t wide_reached(const trav *v, const cdl_skd_wnode *w)
     for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++)
         mask |= ok[i] << i;
     return mask;
+#endif
 }
 
 /* Whether a culling node prunes its subtree: every sample faces away from
  * the ray (d . n / |n| >= C_max, without normalizing n). */
-static int culled(const trav *v, cdl_skd_node nd)
+static int culled(const trav *v, const cdl_skd_wcull *c)
 {
-    float cmax = (float)(nd.b >> 16) / 65535.0f;
-    cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
-    float dv = cdl_dot(v->r->d, n);
-    return dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n);
+    float dv = v->d[0] * c->n[0] + v->d[1] * c->n[1] + v->d[2] * c->n[2];
+    return dv >= 0.0f && dv * dv >= c->c2;
 }
 
 #define WIDE_STACK 512
@@ -342,7 +358,7 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
         v->cnt->nodes++;
         if (e.n == CDL_SKD_WCULL) {
             const cdl_skd_wcull *c = &t->wcull[e.ref];
-            if (!(v->cull && culled(v, t->nodes[c->node]))) {
+            if (!(v->cull && culled(v, c))) {
                 e = c->next;
                 continue;
             }

@@ -7,6 +7,7 @@
  * the same samples with the same weights. */
 #include "spatial/splatkd.h"
 
+#include "core/octahedral.h"
 #include "spatial/splatkd_node.h"
 
 #include <math.h>
@@ -137,7 +138,9 @@ static cdl_skd_went entry_of(wbuild *w, uint32_t node, int top)
             t->wcull = nc;
             t->capwcull = cap;
         }
-        t->wcull[t->nwcull] = (cdl_skd_wcull){node, next};
+        float cmax = (float)(nd.b >> 16) / 65535.0f;
+        cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
+        t->wcull[t->nwcull] = (cdl_skd_wcull){{n.x, n.y, n.z}, cmax * cmax * cdl_dot(n, n), next};
         return (cdl_skd_went){t->nwcull++, CDL_SKD_WCULL};
     }
     if ((nd.b & 3) == 3 || size_of(t, node) <= RANGE_MAX) /* a leaf, or a small subtree */
