@@ -329,6 +329,10 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
         float bl[3], bh[3];
         spheres(t, 0, bl, bh);
     }
+    if (cdl_skd_build_wide(t)) {
+        cdl_skd_free(t);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
+    }
     return 0;
 }
 
@@ -344,11 +348,15 @@ void cdl_skd_free(cdl_skd *t)
     free(t->parts);
     free(t->lsph);
     free(t->range);
+    free(t->wide);
+    free(t->wcull);
+    free(t->wpart);
     memset(t, 0, sizeof *t);
 }
 
 size_t cdl_skd_bytes(const cdl_skd *t)
 {
     return (size_t)t->cap * sizeof(cdl_skd_node) + (size_t)t->nnodes * (4 * sizeof(float) + sizeof(cdl_skd_range)) + (size_t)t->n * (4 + 7 * sizeof(float)) +
-           (size_t)t->nparts * sizeof(cdl_skd_part);
+           (size_t)t->nparts * (sizeof(cdl_skd_part) + sizeof(cdl_skd_went)) + (size_t)t->capwide * sizeof(cdl_skd_wnode) +
+           (size_t)t->capwcull * sizeof(cdl_skd_wcull);
 }

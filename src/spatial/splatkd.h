@@ -36,6 +36,27 @@ typedef struct cdl_skd_part {
     float bmin[3], bmax[3];
 } cdl_skd_part;
 
+/* The wide tree over the binary one (splatkd_wide.c): each wide node
+ * holds up to CDL_SKD_WIDTH children, the frontier of a few collapsed
+ * binary levels, their bounding spheres side by side so that one SIMD
+ * step tests them all. A child (ref, n): n == 0 a wide node; n ==
+ * CDL_SKD_WCULL a culling node (wcull[ref]); otherwise the samples
+ * [ref, ref + n), a subtree small enough to test without descending. */
+#define CDL_SKD_WIDTH 8
+#define CDL_SKD_WCULL UINT32_MAX
+#define CDL_SKD_WEMPTY (UINT32_MAX - 1)
+typedef struct cdl_skd_wnode {
+    float c[4][CDL_SKD_WIDTH]; /* centre x, y, z, radius (-inf: no child) */
+    uint32_t ref[CDL_SKD_WIDTH], n[CDL_SKD_WIDTH];
+} cdl_skd_wnode;
+typedef struct cdl_skd_went {
+    uint32_t ref, n;
+} cdl_skd_went;
+typedef struct cdl_skd_wcull {
+    float n[3], c2;    /* the culling node's mean normal (not unit) and C_max^2 |n|^2 */
+    cdl_skd_went next; /* what follows when it does not cull */
+} cdl_skd_wcull;
+
 typedef struct cdl_skd {
     cdl_skd_node *nodes;
     uint32_t nnodes, cap;
@@ -49,7 +70,16 @@ typedef struct cdl_skd {
     cdl_skd_part *parts;
     uint32_t nparts;
     uint32_t leaves, culls, empties, depth;
+    cdl_skd_wnode *wide;
+    cdl_skd_wcull *wcull;
+    uint32_t nwide, nwcull, capwide, capwcull;
+    cdl_skd_went *wpart; /* per part: its root (n == CDL_SKD_WEMPTY: no sample) */
+    cdl_skd_went wroot;  /* the whole tree's */
 } cdl_skd;
+
+/* Builds the wide tree over a built binary one (spheres and ranges
+ * done); 0 or -1 out of memory. */
+int cdl_skd_build_wide(cdl_skd *t);
 
 typedef struct cdl_skd_params {
     uint32_t leaf_size;     /* 16 */

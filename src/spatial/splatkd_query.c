@@ -49,14 +49,7 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), _mm512_set1_ps(r->o.x));
     __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), _mm512_set1_ps(r->o.y));
     __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), _mm512_set1_ps(r->o.z));
-    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
-           nz = _mm512_loadu_ps(t->nrm[2] + b);
-    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
-    /* -|dn| for a two-sided sample */
-    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
     __m512 z = _mm512_fmadd_ps(Dz, dz, _mm512_fmadd_ps(Dy, dy, _mm512_mul_ps(Dx, dx)));
-    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
-                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
     /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray would
      * lose r^2 to cancellation */
     __m512 ex = _mm512_fnmadd_ps(z, dx, Dx), ey = _mm512_fnmadd_ps(z, dy, Dy), ez = _mm512_fnmadd_ps(z, dz, Dz);
@@ -64,8 +57,21 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     __m512 h = _mm512_fmadd_ps(_mm512_set1_ps(r->dh), _mm512_min_ps(z, len), _mm512_set1_ps(r->h0));
     __m512 h2 = _mm512_mul_ps(h, h), beyond = _mm512_sub_ps(z, len);
     __mmask16 ok = (__mmask16)(m >= 16 ? 0xffffu : (1u << m) - 1u);
-    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
+    /* inside the frustum (h only shrinks beyond the hit) and in front of
+     * the origin: most lanes a large range tests fail here, before the
+     * normals are loaded */
     ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
+    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
+    if (!ok)
+        return 0;
+    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
+           nz = _mm512_loadu_ps(t->nrm[2] + b);
+    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
+    /* -|dn| for a two-sided sample */
+    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
+    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
+                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
+    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
     /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
     __m512 non = _mm512_fmadd_ps(nz, _mm512_set1_ps(r->on.z),
@@ -290,6 +296,95 @@ static void traverse_spheres(const trav *v, uint32_t node)
     }
 }
 
+/* The wide tree's children whose spheres the frustum reaches, as a lane
+ * mask: sphere_reached on every lane at once. */
+static inline uint32_t wide_reached(const trav *v, const cdl_skd_wnode *w)
+{
+    const cdl_splat_ray *r = v->r;
+    const float ox = v->o[0], oy = v->o[1], oz = v->o[2], dx = v->d[0], dy = v->d[1], dz = v->d[2];
+    const float zmax = v->zmax, len = r->len, h0 = r->h0, dh = r->dh;
+#if defined(__AVX512F__) && defined(__AVX512VL__) && CDL_SKD_WIDTH == 8
+    /* the lanes' compares straight into a mask register */
+    __m256 Dx = _mm256_sub_ps(_mm256_loadu_ps(w->c[0]), _mm256_set1_ps(ox));
+    __m256 Dy = _mm256_sub_ps(_mm256_loadu_ps(w->c[1]), _mm256_set1_ps(oy));
+    __m256 Dz = _mm256_sub_ps(_mm256_loadu_ps(w->c[2]), _mm256_set1_ps(oz));
+    __m256 rad = _mm256_loadu_ps(w->c[3]), vdx = _mm256_set1_ps(dx), vdy = _mm256_set1_ps(dy), vdz = _mm256_set1_ps(dz);
+    __m256 z = _mm256_fmadd_ps(Dz, vdz, _mm256_fmadd_ps(Dy, vdy, _mm256_mul_ps(Dx, vdx)));
+    __m256 zr = _mm256_add_ps(z, rad);
+    __m256 ex = _mm256_fnmadd_ps(z, vdx, Dx), ey = _mm256_fnmadd_ps(z, vdy, Dy), ez = _mm256_fnmadd_ps(z, vdz, Dz);
+    __m256 e2 = _mm256_fmadd_ps(ez, ez, _mm256_fmadd_ps(ey, ey, _mm256_mul_ps(ex, ex)));
+    __m256 R = _mm256_add_ps(
+        _mm256_fmadd_ps(_mm256_set1_ps(dh), _mm256_min_ps(zr, _mm256_set1_ps(len)), _mm256_set1_ps(h0)), rad);
+    __mmask8 ok = _mm256_cmp_ps_mask(zr, _mm256_setzero_ps(), _CMP_GE_OQ);
+    ok = _mm256_mask_cmp_ps_mask(ok, _mm256_sub_ps(z, rad), _mm256_set1_ps(zmax), _CMP_LE_OQ);
+    ok = _mm256_mask_cmp_ps_mask(ok, e2, _mm256_mul_ps(R, R), _CMP_LE_OQ);
+    return ok;
+#else
+    uint32_t ok[CDL_SKD_WIDTH];
+#pragma omp simd
+    for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++) {
+        float Dx = w->c[0][i] - ox, Dy = w->c[1][i] - oy, Dz = w->c[2][i] - oz, rad = w->c[3][i];
+        float z = Dx * dx + Dy * dy + Dz * dz, zr = z + rad;
+        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
+        float R = h0 + dh * (zr < len ? zr : len) + rad;
+        ok[i] = (zr >= 0.0f) & (z - rad <= zmax) & (ex * ex + ey * ey + ez * ez <= R * R);
+    }
+    uint32_t mask = 0;
+    for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++)
+        mask |= ok[i] << i;
+    return mask;
+#endif
+}
+
+/* Whether a culling node prunes its subtree: every sample faces away from
+ * the ray (d . n / |n| >= C_max, without normalizing n). */
+static int culled(const trav *v, const cdl_skd_wcull *c)
+{
+    float dv = v->d[0] * c->n[0] + v->d[1] * c->n[1] + v->d[2] * c->n[2];
+    return dv >= 0.0f && dv * dv >= c->c2;
+}
+
+#define WIDE_STACK 512
+
+/* The default traversal on the wide tree from entry e (its sphere
+ * tested), depth first with a stack: the leaves in the binary
+ * traversal's order. */
+static void traverse_wide(const trav *v, cdl_skd_went e)
+{
+    const cdl_skd *t = v->t;
+    cdl_skd_went stack[WIDE_STACK];
+    uint32_t sp = 0;
+    for (;;) {
+        v->cnt->nodes++;
+        if (e.n == CDL_SKD_WCULL) {
+            const cdl_skd_wcull *c = &t->wcull[e.ref];
+            if (!(v->cull && culled(v, c))) {
+                e = c->next;
+                continue;
+            }
+        } else if (e.n == 0) {
+            const cdl_skd_wnode *w = &t->wide[e.ref];
+            uint32_t hit = wide_reached(v, w);
+            if (hit) {
+                uint32_t k = (uint32_t)__builtin_ctz(hit);
+                hit &= hit - 1;
+                while (hit) { /* the rest, last first: the lowest lane pops next */
+                    uint32_t j = 31u - (uint32_t)__builtin_clz(hit);
+                    hit &= ~(1u << j);
+                    stack[sp++] = (cdl_skd_went){w->ref[j], w->n[j]};
+                }
+                e = (cdl_skd_went){w->ref[k], w->n[k]};
+                continue;
+            }
+        } else if (e.n != CDL_SKD_WEMPTY) {
+            test_range(v, e.ref, e.ref + e.n);
+        }
+        if (!sp)
+            return;
+        e = stack[--sp];
+    }
+}
+
 /* Algorithm 1: node over the ray interval [t0, t1]. */
 static void traverse(const trav *v, uint32_t node, float t0, float t1)
 {
@@ -487,10 +582,13 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     }
     if (t0 > t1)
         return 0;
+    cdl_skd_went e = part != UINT32_MAX ? t->wpart[part] : t->wroot;
     if (v.slabs)
         traverse(&v, root, t0, t1);
-    else
+    else if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack */
         traverse_spheres(&v, root);
+    else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
+        traverse_wide(&v, e);
     return 0;
 }
 
