@@ -17,16 +17,15 @@ static inline void cdl_sincos_quarter(float t, float *s, float *c)
 static inline cdl_vec3 cdl_sample_cosine_hemisphere(float u1, float u2)
 {
     /* Concentric disk mapping (Shirley-Chiu) keeps strata compact. */
-    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f, x, y, sn, cs;
+    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f, sn, cs;
     if (a == 0.0f && b == 0.0f)
         return cdl_v3(0.0f, 0.0f, 1.0f);
-    if (fabsf(a) > fabsf(b)) { /* phi = pi/4 b/a */
-        cdl_sincos_quarter((CDL_PI / 4.0f) * (b / a), &sn, &cs);
-        x = a * cs, y = a * sn;
-    } else { /* phi = pi/2 - pi/4 a/b: cos and sin swap */
-        cdl_sincos_quarter((CDL_PI / 4.0f) * (a / b), &sn, &cs);
-        x = b * sn, y = b * cs;
-    }
+    /* |a| > |b|: phi = pi/4 b/a; else phi = pi/2 - pi/4 a/b (cos and sin
+     * swap). Selects, not branches: the side is a coin flip per sample */
+    int wide = fabsf(a) > fabsf(b);
+    float r = wide ? a : b, q = wide ? b : a;
+    cdl_sincos_quarter((CDL_PI / 4.0f) * (q / r), &sn, &cs);
+    float x = r * (wide ? cs : sn), y = r * (wide ? sn : cs);
     return cdl_v3(x, y, sqrtf(cdl_maxf(0.0f, 1.0f - x * x - y * y)));
 }
 
