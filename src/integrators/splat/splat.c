@@ -299,26 +299,30 @@ static int build(splat_state *s, cdl_error *err)
         return err->code;
     if (!s->eye && !(s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1))))
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the eye samples");
+    /* 336-byte records gathered from all over: in parallel */
+#pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++)
         s->eye[q] = s->slot[s->tree.order[q]];
     return splat_maps_alloc(s, err);
 }
 
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* The rays put in Morton order of their ends (the report's presorting of
  * photon rays): consecutive rays meet the same nodes and eye samples, so
- * the traversal's branches repeat and the samples stay in cache. */
+ * the traversal's branches repeat and the samples stay in cache. Keys are
+ * 30-bit Morton codes over the ray index, sorted by three stable radix
+ * passes of 10 bits (the order of a sort on (code, index)); the rays are
+ * then gathered in parallel into a new array (a cycle-by-cycle walk in
+ * place, a chain of dependent cache misses, is the fallback without the
+ * memory for one). */
 static int sort_rays(splat_state *s, cdl_error *err)
 {
     uint32_t n = s->rays.n;
-    uint64_t *key = malloc(sizeof *key * (n ? n : 1));
-    if (!key)
+    uint64_t *key = malloc(sizeof *key * (n ? n : 1)), *tmp = malloc(sizeof *tmp * (n ? n : 1));
+    if (!key || !tmp) {
+        free(key);
+        free(tmp);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for %u photon rays", n);
+    }
     const float *lo = &s->scene->bmin.x, *hi = &s->scene->bmax.x;
     float ext = cdl_maxf(hi[0] - lo[0], cdl_maxf(hi[1] - lo[1], hi[2] - lo[2]));
     float sc = ext > 0.0f ? 1023.0f / ext : 0.0f;
@@ -328,14 +332,36 @@ static int sort_rays(splat_state *s, cdl_error *err)
         cdl_vec3 e = cdl_add(r[k].o, cdl_scale(r[k].d, r[k].len));
         key[k] = cdl_morton3(&e.x, lo, sc) << 32 | k;
     }
-    qsort(key, n, sizeof *key, cmp_u64);
-    /* in place, cycle by cycle: position k takes ray key[k]; a done
-     * position is marked by its key's index set to k */
+    for (int shift = 32; shift < 62; shift += 10) {
+        uint32_t count[1025] = {0};
+        for (uint32_t k = 0; k < n; k++)
+            count[(key[k] >> shift & 1023u) + 1]++;
+        for (int b = 0; b < 1024; b++)
+            count[b + 1] += count[b];
+        for (uint32_t k = 0; k < n; k++)
+            tmp[count[key[k] >> shift & 1023u]++] = key[k];
+        uint64_t *sw = key;
+        key = tmp;
+        tmp = sw;
+    }
+    free(tmp);
+    cdl_photon_ray *out = malloc(sizeof *out * (s->rays.cap ? s->rays.cap : 1));
+    if (out) {
+#pragma omp parallel for schedule(static)
+        for (uint32_t k = 0; k < n; k++)
+            out[k] = r[(uint32_t)key[k]];
+        free(r);
+        s->rays.r = out;
+        free(key);
+        return 0;
+    }
+    /* position k takes ray key[k]; a done position is marked by its key's
+     * index set to k */
     for (uint32_t k = 0; k < n; k++) {
         uint32_t src = (uint32_t)key[k];
         if (src == k)
             continue;
-        cdl_photon_ray tmp = r[k];
+        cdl_photon_ray t = r[k];
         uint32_t j = k;
         while (src != k) {
             r[j] = r[src];
@@ -343,7 +369,7 @@ static int sort_rays(splat_state *s, cdl_error *err)
             j = src;
             src = (uint32_t)key[j];
         }
-        r[j] = tmp;
+        r[j] = t;
         key[j] = (key[j] & ~(uint64_t)UINT32_MAX) | j;
     }
     free(key);
