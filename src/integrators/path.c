@@ -31,14 +31,12 @@ static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *o
 /* Direct light at a surface point by light sampling, MIS-weighted
  * against the BSDF having found the same point. */
 static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b,
-                           cdl_vec3 wo, cdl_sampler *smp, uint64_t *rays)
+                           cdl_vec3 wo, const float *u, uint64_t *rays)
 {
-    float pmf, us, ua, u1, u2;
-    cdl_sampler_2d(smp, &us, &ua);
-    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, us, ua, &pmf)];
+    float pmf;
+    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, u[0], u[1], &pmf)];
     cdl_light_sample ls;
-    cdl_sampler_2d(smp, &u1, &u2);
-    if (!cdl_light_sample_li(l, sf->p, u1, u2, &ls))
+    if (!cdl_light_sample_li(l, sf->p, u[2], u[3], &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float pdf_b;
     cdl_vec3 f = cdl_bsdf_eval_pdf(b, wo, ls.wi, 0, &pdf_b);
@@ -93,12 +91,20 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
             break;
         cdl_bsdf b;
         cdl_scene_bsdf(s, &sf, &b);
-        if (!cdl_bsdf_is_delta(&b))
-            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, smp, rays)));
+        /* the vertex's numbers drawn together, in the order they are used:
+         * their hash chains are independent and overlap */
+        float u[7];
+        int nee = !cdl_bsdf_is_delta(&b);
+        if (nee) {
+            cdl_sampler_2d(smp, &u[0], &u[1]);
+            cdl_sampler_2d(smp, &u[2], &u[3]);
+        }
+        u[4] = cdl_sampler_1d(smp);
+        cdl_sampler_2d(smp, &u[5], &u[6]);
+        if (nee)
+            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, u, rays)));
         cdl_scatter bs;
-        float u0 = cdl_sampler_1d(smp), u1, u2;
-        cdl_sampler_2d(smp, &u1, &u2);
-        if (!cdl_bsdf_sample(&b, wo, u0, u1, u2, 0, &bs))
+        if (!cdl_bsdf_sample(&b, wo, u[4], u[5], u[6], 0, &bs))
             break;
         beta = cdl_mul(beta, bs.weight);
         specular = bs.delta;

@@ -310,6 +310,13 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     float gi = cdl_dot(wi, b->ng);
     if (gi * go <= 0.0f || fabsf(gi) < 1e-6f)
         return 0;
+    if (b->type == CDL_MAT_DIFFUSE) { /* kd/pi cos over cos/pi: no division to wait for */
+        s->wi = wi;
+        s->delta = 0;
+        s->pdf = li.z * CDL_INV_PI;
+        s->weight = b->kd;
+        return 1;
+    }
     float pdf;
     cdl_vec3 f = opaque_eval(b, lo, li, &pdf);
     if (!(pdf > 0.0f))
