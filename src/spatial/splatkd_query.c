@@ -176,15 +176,15 @@ typedef struct trav {
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
-    int cull, slabs, any;
+    int cull, slabs, both;
     cdl_skd_visit fn;
+    cdl_skd_visit_both fnb;
     void *ctx;
     cdl_skd_count *cnt;
 } trav;
 
-/* CDL_SKD_ANY's leaf test: inside the frustum, any facing; zz gets z. */
-static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float zmax, float *w,
-                          float *zz)
+/* The both visit's frustum test: inside the frustum, any facing; zz gets z. */
+static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float zmax, float *zz)
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float len = r->len, h0 = r->h0, dh = r->dh;
@@ -198,7 +198,6 @@ static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_sp
         float h = h0 + dh * (z < len ? z : len);
         ok[i] = (z >= 0.0f) & (z <= zmax) & (ex * ex + ey * ey + ez * ez < h * h) & (i < m);
         zz[i] = z;
-        w[i] = 0.0f;
     }
     uint32_t mask = 0;
     for (uint32_t i = 0; i < 16; i++)
@@ -206,19 +205,25 @@ static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_sp
     return mask;
 }
 
-static void test_range(const trav *v, uint32_t lo, uint32_t hi)
+/* Samples [lo, hi); culled: under a culling node that prunes them (only
+ * the both visit gets there, for the frustum's lanes). */
+static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
 {
     v->cnt->tested += hi - lo;
-    if (v->any) {
+    if (v->both) {
+        v->cnt->weighed += culled ? 0 : hi - lo;
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
-            float w[16], zz[16];
-            uint32_t in = frustum16(v->t, b, m, v->r, v->zmax, w, zz);
-            if (in)
-                v->fn(v->ctx, b, m, in, w, zz);
+            float z[16], w[16], iz[16];
+            uint32_t in = frustum16(v->t, b, m, v->r, v->zmax, z), feas = 0;
+            if (!culled)
+                feas = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, iz) : weigh16(v->t, b, m, v->r, 0, w, iz);
+            if (in | feas)
+                v->fnb(v->ctx, b, m, in, z, feas, w, iz);
         }
         return;
     }
+    v->cnt->weighed += hi - lo;
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
@@ -249,13 +254,14 @@ static int sphere_reached(const trav *v, uint32_t node)
 }
 
 /* A leaf, empty or culling node: 1 if the traversal goes on to the
- * culling node's child (node + 1). */
-static inline int special_node(const trav *v, cdl_skd_node nd)
+ * culling node's child (node + 1); *culled becomes 1 below a culling
+ * node that prunes in the both visit. */
+static inline int special_node(const trav *v, cdl_skd_node nd, int *culled)
 {
     uint32_t kind = (nd.b >> 2) & 3;
     if (kind == KIND_LEAF) {
         uint32_t lo = nd.b >> 4;
-        test_range(v, lo, lo + nd.a);
+        test_range(v, lo, lo + nd.a, *culled);
         return 0;
     }
     if (kind == KIND_EMPTY)
@@ -266,15 +272,18 @@ static inline int special_node(const trav *v, cdl_skd_node nd)
         float cmax = (float)(nd.b >> 16) / 65535.0f;
         cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
         float dv = cdl_dot(v->r->d, n);
-        if (dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n))
-            return 0;
+        if (dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n)) {
+            if (!v->both)
+                return 0;
+            *culled = 1;
+        }
     }
     return 1;
 }
 
 /* The default traversal: every node whose bounding sphere the frustum
  * reaches (empty nodes have none). */
-static void traverse_spheres(const trav *v, uint32_t node)
+static void traverse_spheres(const trav *v, uint32_t node, int culled)
 {
     const cdl_skd *t = v->t;
     for (;;) {
@@ -284,14 +293,14 @@ static void traverse_spheres(const trav *v, uint32_t node)
             uint32_t kind = (nd.b >> 2) & 3;
             if (kind != KIND_CULL && (kind == KIND_EMPTY || !sphere_reached(v, node)))
                 return;
-            if (!special_node(v, nd))
+            if (!special_node(v, nd, &culled))
                 return;
             node++;
             continue;
         }
         if (!sphere_reached(v, node))
             return;
-        traverse_spheres(v, node + 1);
+        traverse_spheres(v, node + 1, culled);
         node = nd.b >> 2;
     }
 }
@@ -353,12 +362,16 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
 {
     const cdl_skd *t = v->t;
     cdl_skd_went stack[WIDE_STACK];
-    uint32_t sp = 0;
+    /* the both visit: the stack's entries from `cut` up lie under a
+     * culling node that prunes (UINT32_MAX: none) */
+    uint32_t sp = 0, cut = UINT32_MAX;
     for (;;) {
         v->cnt->nodes++;
         if (e.n == CDL_SKD_WCULL) {
             const cdl_skd_wcull *c = &t->wcull[e.ref];
-            if (!(v->cull && culled(v, c))) {
+            if (!(v->cull && culled(v, c)) || v->both) {
+                if (v->cull && cut == UINT32_MAX && culled(v, c))
+                    cut = sp;
                 e = c->next;
                 continue;
             }
@@ -377,16 +390,18 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
                 continue;
             }
         } else if (e.n != CDL_SKD_WEMPTY) {
-            test_range(v, e.ref, e.ref + e.n);
+            test_range(v, e.ref, e.ref + e.n, cut != UINT32_MAX);
         }
         if (!sp)
             return;
         e = stack[--sp];
+        if (sp < cut)
+            cut = UINT32_MAX;
     }
 }
 
 /* Algorithm 1: node over the ray interval [t0, t1]. */
-static void traverse(const trav *v, uint32_t node, float t0, float t1)
+static void traverse(const trav *v, uint32_t node, float t0, float t1, int culled)
 {
     const cdl_skd *t = v->t;
     for (;;) {
@@ -394,7 +409,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         cdl_skd_node nd = t->nodes[node];
         uint32_t ty = nd.b & 3;
         if (ty == 3) {
-            if (!special_node(v, nd))
+            if (!special_node(v, nd, &culled))
                 return;
             node++;
             continue;
@@ -405,7 +420,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         if (v->d[a] == 0.0f) {
             int go_l = v->o[a] - R1 <= s, go_r = v->o[a] + R1 >= s;
             if (go_l && go_r) {
-                traverse(v, left, t0, t1);
+                traverse(v, left, t0, t1, culled);
                 node = right;
             } else {
                 node = go_l ? left : right;
@@ -418,7 +433,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         uint32_t front = v->d[a] > 0.0f ? left : right, back = v->d[a] > 0.0f ? right : left;
         int go_f = t0 <= tb, go_b = t1 >= ta;
         if (go_f && go_b) {
-            traverse(v, front, t0, tb < t1 ? tb : t1);
+            traverse(v, front, t0, tb < t1 ? tb : t1, culled);
             node = back;
             t0 = ta > t0 ? ta : t0;
         } else if (go_f) {
@@ -511,7 +526,8 @@ static void traverse_stop(const stop_trav *s, uint32_t node)
             return;
         }
         if ((nd.b & 3) == 3) {
-            if (kind == KIND_LEAF || !special_node(v, nd))
+            int culled = 0;
+            if (kind == KIND_LEAF || !special_node(v, nd, &culled))
                 return;
             node++;
             continue;
@@ -528,13 +544,13 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, cnt},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, NULL, cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
 
-int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
-                        void *ctx, cdl_skd_count *cnt)
+static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                 cdl_skd_visit_both fnb, void *ctx, cdl_skd_count *cnt)
 {
     if (!t->n)
         return 0;
@@ -553,10 +569,11 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
               {r->d.x, r->d.y, r->d.z},
               {0.0f, 0.0f, 0.0f},
               0.0f,
-              (flags & (CDL_SKD_CULL | CDL_SKD_ANY)) == CDL_SKD_CULL,
+              (flags & CDL_SKD_CULL) != 0,
               (flags & CDL_SKD_SLABS) != 0,
-              (flags & CDL_SKD_ANY) != 0,
+              fnb != NULL,
               fn,
+              fnb,
               ctx,
               cnt};
     for (int a = 0; a < 3; a++)
@@ -584,12 +601,24 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return 0;
     cdl_skd_went e = part != UINT32_MAX ? t->wpart[part] : t->wroot;
     if (v.slabs)
-        traverse(&v, root, t0, t1);
+        traverse(&v, root, t0, t1, 0);
     else if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack */
-        traverse_spheres(&v, root);
+        traverse_spheres(&v, root, 0);
     else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
         traverse_wide(&v, e);
     return 0;
+}
+
+int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                        void *ctx, cdl_skd_count *cnt)
+{
+    return visit(t, part, r, flags, fn, NULL, ctx, cnt);
+}
+
+int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,
+                             cdl_skd_count *cnt)
+{
+    return visit(t, UINT32_MAX, r, flags, NULL, fn, ctx, cnt);
 }
 
 static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *z)
@@ -602,7 +631,7 @@ static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const f
 
 int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_splat_hits *out)
 {
-    cdl_skd_count cnt = {0, 0};
+    cdl_skd_count cnt = {0, 0, 0};
     cdl_skd_splat_visit(t, part, r, flags, append, out, &cnt);
     out->tested += cnt.tested;
     out->nodes += cnt.nodes;
