@@ -38,19 +38,8 @@
 
 #include "core/grow.h"
 #include "integrators/splat/mask.h"
+#include "integrators/splat/mask_ray.h"
 
-#define MASK_G 32
-
-/* A traversal batch held until the ray's buffer is known: the frustum's
- * lanes with their z, or the feasible ones with w and 1 / z. */
-typedef struct mask_held {
-    uint32_t first, mask;
-    float z[16];
-} mask_held;
-typedef struct mask_feas {
-    uint32_t first, mask;
-    float w[16], iz[16];
-} mask_feas;
 /* A kept batch: its lanes' w then 1 / z from val[off], packed. */
 typedef struct mask_rec {
     uint32_t first, keep, off;
@@ -80,8 +69,9 @@ struct splat_mask {
     uint32_t first;     /* the batch's first ray */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
     float *pw;          /* per eye sample (tree order) its footprint, contiguous for the leaf loops */
-    float *ax[6];       /* and the semi-axes of the surface patch it stands for (see rasterize) */
+    float *ax[6];       /* and the semi-axes of the surface patch it stands for (see prepare) */
     uint32_t npw;
+    float scale;        /* the largest coordinate of the samples' box */
     mask_worker *w;
     int nw;
     uint32_t *rth;      /* per ray of the batch: the worker that took it, */
@@ -196,6 +186,9 @@ int splat_mask_prepare(splat_state *s)
     }
     uint32_t n = s->tree.n < 4096 ? s->tree.n : 4096, step = n ? s->tree.n / n : 1;
     float *f = malloc(sizeof *f * (n ? n : 1));
+    m->scale = 0.0f;
+    for (int a = 0; a < 3; a++)
+        m->scale = fmaxf(m->scale, fmaxf(fabsf(s->tree.bmin[a]), fabsf(s->tree.bmax[a])));
     m->rho = 0.0f; /* without memory: the full grid */
     if (!f)
         return 0;
@@ -235,210 +228,6 @@ static void collect(void *ctx, uint32_t first, uint32_t m, uint32_t any, const f
         memcpy(e->w, w, sizeof e->w);
         memcpy(e->iz, iz, sizeof e->iz);
     }
-}
-
-/* Whether the held samples that can hide anything (not on the surface the
- * ray leaves) lie on one plane: within a quarter of the smallest footprint
- * of the first one's plane, normals within 0.1 degree. No sample of a
- * plane hides another (the filter's test needs one behind another's
- * tangent plane by its footprint), so such a ray needs no mask. The
- * largest distance only grows and the smallest footprint only shrinks
- * sample by sample, so testing them over a whole batch at once decides
- * the same. */
-static int one_plane(const splat_state *s, const cdl_photon_ray *r, const mask_held *h, uint32_t nh)
-{
-    const cdl_skd *t = &s->tree;
-    const float *pw = s->mask->pw;
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z;
-    uint32_t k = 0, q0 = UINT32_MAX;
-    for (; k < nh && q0 == UINT32_MAX; k++)
-        for (uint32_t mask = h[k].mask; mask; mask &= mask - 1) {
-            uint32_t q = h[k].first + (uint32_t)__builtin_ctz(mask);
-            float so = (t->p[0][q] - ox) * t->nrm[0][q] + (t->p[1][q] - oy) * t->nrm[1][q] +
-                       (t->p[2][q] - oz) * t->nrm[2][q];
-            if (fabsf(so) > pw[q]) { /* not the origin's surface (as rasterize) */
-                q0 = q;
-                break;
-            }
-        }
-    if (q0 == UINT32_MAX)
-        return 1;
-    const float p0x = t->p[0][q0], p0y = t->p[1][q0], p0z = t->p[2][q0];
-    const float n0x = t->nrm[0][q0], n0y = t->nrm[1][q0], n0z = t->nrm[2][q0];
-    float dmax = 0.0f, pmin = INFINITY;
-    for (k = k ? k - 1 : 0; k < nh; k++) {
-        const uint32_t b = h[k].first, mask = h[k].mask;
-        const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
-        const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b, *pb = pw + b;
-        int bent = 0;
-#pragma omp simd reduction(max : dmax) reduction(min : pmin) reduction(| : bent)
-        for (uint32_t i = 0; i < 16; i++) {
-            float so = (px[i] - ox) * nx[i] + (py[i] - oy) * ny[i] + (pz[i] - oz) * nz[i];
-            int ok = (int)(mask >> i & 1u) & (fabsf(so) > pb[i]);
-            float d = fabsf((px[i] - p0x) * n0x + (py[i] - p0y) * n0y + (pz[i] - p0z) * n0z);
-            bent |= ok & (nx[i] * n0x + ny[i] * n0y + nz[i] * n0z < 0.9999985f);
-            dmax = ok && d > dmax ? d : dmax;
-            pmin = ok && pb[i] < pmin ? pb[i] : pmin;
-        }
-        if (bent || dmax > 0.25f * pmin)
-            return 0;
-    }
-    return 1;
-}
-
-/* z-min of a cell with key (a branch-free select: the loads forward
- * from the stores of the lanes before, which hit the same cells). */
-static inline void cell_min(uint64_t *c, uint64_t key) { *c = key < *c ? key : *c; }
-
-static inline uint32_t float_bits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-
-static inline float bits_float(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-/* One held batch into the ray's buffer (g x g cells, frame U, V). */
-static void rasterize(const splat_state *s, const cdl_photon_ray *r, const float *U, const float *V, int g,
-                      uint64_t *grid, const mask_held *hb)
-{
-    const cdl_skd *t = &s->tree;
-    const splat_mask *mk = s->mask;
-    const uint32_t first = hb->first;
-    const float *zz = hb->z;
-    const float ics = 0.5f * (float)g;
-    const float h0 = r->h0, dh = r->dh, len = r->len;
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
-    const float *nx = t->nrm[0] + first, *ny = t->nrm[1] + first, *nz = t->nrm[2] + first, *pw = mk->pw + first;
-    const float *ax[6];
-    for (int c = 0; c < 6; c++)
-        ax[c] = mk->ax[c] + first;
-    int box[4][16], keep[16];
-    /* the cells each lane covers, 16 at a time (lanes past m are masked) */
-#pragma omp simd
-    for (int i = 0; i < 16; i++) {
-        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz, z = zz[i];
-        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
-        /* the surface the ray leaves hides nothing, and in the cells
-         * around the ray it would stand in front of what does */
-        float so = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
-        keep[i] = fabsf(so) > pw[i];
-        /* in the kernel's plane: lateral offsets over the radius at z */
-        float ih = ics / (h0 + dh * (z < len ? z : len));
-        float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g;
-        float v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + 0.5f * (float)g;
-        /* the patch's ellipse seen along d: its half extents in u and v */
-        float t1 = ax[0][i] * U[0] + ax[1][i] * U[1] + ax[2][i] * U[2], b1 = ax[3][i] * U[0] + ax[4][i] * U[1] + ax[5][i] * U[2];
-        float t2 = ax[0][i] * V[0] + ax[1][i] * V[1] + ax[2][i] * V[2], b2 = ax[3][i] * V[0] + ax[4][i] * V[1] + ax[5][i] * V[2];
-        float fu = sqrtf(t1 * t1 + b1 * b1) * ih, fv = sqrtf(t2 * t2 + b2 * b2) * ih;
-        /* + 1 so truncation floors; clamped to the grid */
-        /* (comparisons, not fminf: the loop stays vectorized) */
-        float u0 = u - fu + 1.0f, u1 = u + fu + 1.0f, v0 = v - fv + 1.0f, v1 = v + fv + 1.0f, G = (float)g;
-        u0 = u0 > 1.0f ? u0 : 1.0f, u1 = u1 > 0.0f ? u1 : 0.0f, v0 = v0 > 1.0f ? v0 : 1.0f, v1 = v1 > 0.0f ? v1 : 0.0f;
-        box[0][i] = (int)(u0 < G ? u0 : G) - 1;
-        box[1][i] = (int)(u1 < G ? u1 : G) - 1;
-        box[2][i] = (int)(v0 < G ? v0 : G) - 1;
-        box[3][i] = (int)(v1 < G ? v1 : G) - 1;
-    }
-    uint32_t live = 0;
-    for (int i = 0; i < 16; i++)
-        live |= (uint32_t)(keep[i] != 0) << i;
-    for (uint32_t mask = hb->mask & live; mask; mask &= mask - 1) {
-        int i = __builtin_ctz(mask);
-        /* + 0: -0 becomes +0, whose bits order with the rest */
-        uint64_t key = (uint64_t)float_bits(zz[i] + 0.0f) << 32 | (first + (uint32_t)i);
-        const int a0 = box[0][i], a1 = box[1][i], b0 = box[2][i], b1 = box[3][i];
-        if (a1 < a0 || b1 < b0)
-            continue;
-        if (a1 - a0 <= 1 && b1 - b0 <= 1) {
-            /* at most 2 x 2 cells, most of them: the 4 corners, a
-             * narrower box repeating some (z-min twice changes nothing) */
-            uint64_t *r0 = grid + b0 * g, *r1 = grid + b1 * g;
-            cell_min(r0 + a0, key);
-            cell_min(r0 + a1, key);
-            cell_min(r1 + a0, key);
-            cell_min(r1 + a1, key);
-            continue;
-        }
-        for (int b = b0; b <= b1; b++)
-            for (int a = a0; a <= a1; a++)
-                cell_min(grid + b * g + a, key);
-    }
-}
-
-/* Drops from a feasible batch the samples the ray's buffer hides. */
-static uint32_t filter(const splat_state *s, const cdl_photon_ray *r, const float *U, const float *V, int g,
-                       const uint64_t *grid, const mask_feas *fb)
-{
-    const splat_mask *m = s->mask;
-    const cdl_skd *t = &s->tree;
-    const uint32_t first = fb->first, mask = fb->mask;
-    const float *iz = fb->iz;
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float h0 = r->h0, dh = r->dh, len = r->len, ics = 0.5f * (float)g, half = ics;
-    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = m->pw + first;
-    int cell[16], zb[16];
-    uint32_t occ[16];
-    /* each lane's cell, 16 at a time (-1: outside the grid) */
-#pragma omp simd
-    for (int i = 0; i < 16; i++) {
-        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
-        float ex = px[i] - ox - z * dx, ey = py[i] - oy - z * dy, ez = pz[i] - oz - z * dz;
-        float ih = ics / (h0 + dh * (z < len ? z : len));
-        float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + half, v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + half;
-        int in = u >= 0.0f && v >= 0.0f && u < (float)g && v < (float)g;
-        cell[i] = in ? (int)v * g + (int)u : -1;
-        zb[i] = (int32_t)float_bits(z - pw[i]);
-    }
-    /* a candidate has a front sample (not itself) nearer by more than its
-     * footprint: distances >= 0 order as their bits, and a negative
-     * z - pw (a negative int) has none nearer */
-#if defined(__AVX512F__)
-    const __m512i c = _mm512_loadu_si512(cell), none = _mm512_set1_epi64(-1);
-    const __mmask16 in = _mm512_mask_cmpge_epi32_mask((__mmask16)mask, c, _mm512_setzero_si512());
-    __m512i klo = _mm512_mask_i32gather_epi64(none, (__mmask8)in, _mm512_castsi512_si256(c), grid, 8);
-    __m512i khi = _mm512_mask_i32gather_epi64(none, (__mmask8)(in >> 8), _mm512_extracti64x4_epi64(c, 1), grid, 8);
-    /* the keys' low halves (samples) and high halves (distance bits) */
-    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-    __m512i o = _mm512_permutex2var_epi32(klo, even, khi);
-    __m512i zk = _mm512_permutex2var_epi32(klo, _mm512_add_epi32(even, _mm512_set1_epi32(1)), khi);
-    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    __mmask16 cm = _mm512_mask_cmpneq_epi32_mask(in, o, _mm512_set1_epi32(-1));
-    cm = _mm512_mask_cmpneq_epi32_mask(cm, o, _mm512_add_epi32(lane, _mm512_set1_epi32((int)first)));
-    cm = _mm512_mask_cmplt_epi32_mask(cm, zk, _mm512_loadu_si512(zb));
-    _mm512_storeu_si512(occ, o);
-    uint32_t hit = cm;
-#else
-    uint32_t hit = 0;
-    for (int i = 0; i < 16; i++) {
-        if (!(mask >> i & 1u) || cell[i] < 0)
-            continue;
-        uint64_t key = grid[cell[i]];
-        occ[i] = (uint32_t)key;
-        hit |= (uint32_t)((occ[i] != UINT32_MAX) & (occ[i] != first + (uint32_t)i) &
-                          ((int32_t)(uint32_t)(key >> 32) < zb[i])) << i;
-    }
-#endif
-    uint32_t keep = mask;
-    for (hit &= mask; hit; hit &= hit - 1) {
-        uint32_t i = (uint32_t)__builtin_ctz(hit), o = occ[i];
-        /* hidden if the sample lies on the far side of the occluder's
-         * tangent plane from the ray's origin; an occluder whose plane
-         * holds the origin (the surface the ray leaves) hides nothing */
-        float rho = pw[i], nx = t->nrm[0][o], ny = t->nrm[1][o], nz = t->nrm[2][o];
-        float so = (ox - t->p[0][o]) * nx + (oy - t->p[1][o]) * ny + (oz - t->p[2][o]) * nz;
-        float sy = (px[i] - t->p[0][o]) * nx + (py[i] - t->p[1][o]) * ny + (pz[i] - t->p[2][o]) * nz;
-        if (fabsf(so) > m->pw[o] && (so > 0.0f ? sy < -rho : sy > rho))
-            keep &= ~(1u << i);
-    }
-    return keep;
 }
 
 /* Packs the kept lanes' w and 1 / z at val (2 popcount(keep) floats). */
@@ -481,7 +270,7 @@ static inline void unpack(const float *val, uint32_t keep, float *w, float *iz)
 }
 
 typedef struct build_count {
-    uint64_t tested, weighed, nodes, rasterized, masks, masked;
+    uint64_t tested, weighed, nodes, rasterized, masks, buffers, masked;
 } build_count;
 
 /* Ray k of the batch on worker wid: one traversal, its mask if the
@@ -504,22 +293,26 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     if (x->oom)
         return;
     cdl_frame f = cdl_frame_from(r->d);
-    const float U[3] = {f.t.x, f.t.y, f.t.z}, V[3] = {f.b.x, f.b.y, f.b.z};
+    float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
+    mask_ray mr = {&s->tree, r, m->pw, (const float *const *)m->ax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
+                   /* ~10x the rounding of a plane offset at the coordinates' scale */
+                   1e-5f * big, 0, INT32_MIN, x->grid};
     float hmax = r->h0 + r->dh * r->len;
-    int g = 0; /* no mask unless the frustum holds more than one plane */
-    if (hmax > 0.0f && !one_plane(s, r, x->held, x->nh)) {
+    /* a mask if the frustum holds more than one plane, a buffer if one
+     * of them may hide a feasible sample */
+    if (hmax > 0.0f && x->nf && !splat_mask_one_plane(&mr, x->held, x->nh)) {
         bc->masks++;
-        g = MASK_G;
-        if (2.0f * hmax < (float)g * m->rho)
-            g = (int)ceilf(2.0f * hmax / m->rho);
-        g = g < 1 ? 1 : g;
-        if (x->nf) { /* nothing to filter: no buffer either */
-            for (int c = 0; c < g * g; c++)
+        splat_mask_reach(&mr, x->feas, x->nf);
+        if (splat_mask_may_hide(&mr, x->held, x->nh, x->feas, x->nf)) {
+            bc->buffers++;
+            int g = MASK_G;
+            if (2.0f * hmax < (float)g * m->rho)
+                g = (int)ceilf(2.0f * hmax / m->rho);
+            mr.g = g < 1 ? 1 : g;
+            for (int c = 0; c < mr.g * mr.g; c++)
                 x->grid[c] = UINT64_MAX;
-            for (uint32_t b = 0; b < x->nh; b++) {
-                rasterize(s, r, U, V, g, x->grid, &x->held[b]);
-                bc->rasterized += (uint64_t)__builtin_popcount(x->held[b].mask);
-            }
+            for (uint32_t b = 0; b < x->nh; b++)
+                bc->rasterized += splat_mask_rasterize(&mr, &x->held[b]);
         }
     }
     const cdl_skd_part *parts = s->tree.parts;
@@ -527,7 +320,7 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     uint32_t p = 0, cur = UINT32_MAX;
     for (uint32_t j = 0; j < x->nf; j++) {
         const mask_feas *fb = &x->feas[j];
-        uint32_t keep = g ? filter(s, r, U, V, g, x->grid, fb) : fb->mask;
+        uint32_t keep = mr.g ? splat_mask_filter(&mr, fb) : fb->mask;
         bc->masked += (uint64_t)__builtin_popcount(fb->mask & ~keep);
         if (!keep)
             continue;
@@ -621,10 +414,10 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
     m->first = first;
     if (workers(m))
         return CDL_ERR_SYSTEM;
-    build_count bc = {0, 0, 0, 0, 0, 0};
+    build_count bc = {0, 0, 0, 0, 0, 0, 0};
 #pragma omp parallel
     {
-        build_count c = {0, 0, 0, 0, 0, 0};
+        build_count c = {0, 0, 0, 0, 0, 0, 0};
         uint32_t wid = (uint32_t)omp_get_thread_num();
 #pragma omp for schedule(dynamic, 64)
         for (uint32_t k = 0; k < n; k++)
@@ -632,7 +425,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
 #pragma omp critical(splat_mask_count)
         {
             bc.tested += c.tested, bc.weighed += c.weighed, bc.nodes += c.nodes;
-            bc.rasterized += c.rasterized, bc.masks += c.masks, bc.masked += c.masked;
+            bc.rasterized += c.rasterized, bc.masks += c.masks, bc.buffers += c.buffers, bc.masked += c.masked;
         }
     }
     for (int i = 0; i < m->nw; i++)
@@ -645,6 +438,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
     s->st.nodes += bc.nodes;
     s->st.rasterized += bc.rasterized;
     s->st.mask_rays += bc.masks;
+    s->st.mask_buffers += bc.buffers;
     s->st.masked += bc.masked;
     return 0;
 }
