@@ -26,9 +26,19 @@ static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
     return 0;
 }
 
+/* The both visit's frustum test, on the way (see cdl_skd_visit_both):
+ * lanes inside the frustum up to zmax and their z; culled: the leaf test
+ * is not wanted. */
+typedef struct any16 {
+    float zmax;
+    int culled;
+    uint32_t mask;
+    float *z;
+} any16;
+
 /* Algorithm 2's feasibility and weight for up to 16 samples from b:
  * w[i] kernel times cosine (0 where infeasible), zz[i] 1 / z; returns
- * the mask of feasible lanes. `plane` is a constant in each caller;
+ * the mask of feasible lanes; with a, the frustum test too. `plane` is a constant in each caller;
  * cdl_splat_weight is the same test one sample at a time. With AVX-512
  * the 16 lanes are one register and the reciprocals rcp14 with a Newton
  * step (relative error ~1e-7); otherwise a branch-free loop that the
@@ -41,7 +51,7 @@ static inline __m512 rcp_nr(__m512 x)
 }
 
 static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane,
-                               float *w, float *zz)
+                               float *w, float *zz, any16 *a)
 {
     const __m512 zero = _mm512_setzero_ps();
     const __m512 dx = _mm512_set1_ps(r->d.x), dy = _mm512_set1_ps(r->d.y), dz = _mm512_set1_ps(r->d.z);
@@ -62,6 +72,12 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
      * normals are loaded */
     ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
+    if (a) {
+        a->mask = _mm512_mask_cmp_ps_mask(ok, z, _mm512_set1_ps(a->zmax), _CMP_LE_OQ);
+        _mm512_storeu_ps(a->z, z);
+        if (a->culled)
+            return 0;
+    }
     if (!ok)
         return 0;
     __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
@@ -114,8 +130,8 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     return ok;
 }
 #else
-static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
-                        float *zz)
+static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
+                               float *zz, any16 *a)
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
@@ -124,6 +140,9 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
     const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
     const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
     const float *two = t->two + b;
+    const float zmax = a ? a->zmax : 0.0f;
+    float zo[16];
+    int in[16];
 #pragma omp simd
     for (uint32_t i = 0; i < 16; i++) { /* all 16 lanes (the arrays have room): a fixed trip count */
         float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
@@ -137,6 +156,8 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         float r2 = ex * ex + ey * ey + ez * ez;
         float h = h0 + dh * (z < len ? z : len);
         float h2 = h * h, beyond = z - len;
+        in[i] = (z >= 0.0f) & (z <= zmax) & (r2 < h2) & (i < m);
+        zo[i] = z;
         float non = nx[i] * nx0 + ny[i] * ny0 + nz[i] * nz0;
         /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f) & ((zn >= zmin) | (non >= CDL_SKD_SHEET_COS));
@@ -159,6 +180,14 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         w[i] = ok ? wi : 0.0f;
         zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
+    if (a) {
+        a->mask = 0;
+        for (uint32_t i = 0; i < 16; i++)
+            a->mask |= (uint32_t)in[i] << i;
+        memcpy(a->z, zo, sizeof zo);
+        if (a->culled)
+            return 0;
+    }
     uint32_t mask = 0;
     for (uint32_t i = 0; i < 16; i++)
         mask |= (uint32_t)(w[i] > 0.0f) << i;
@@ -168,7 +197,7 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 
 uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz)
 {
-    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz) : weigh16(t, b, m, r, 0, w, iz);
+    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz, NULL) : weigh16(t, b, m, r, 0, w, iz, NULL);
 }
 
 typedef struct trav {
@@ -183,28 +212,6 @@ typedef struct trav {
     cdl_skd_count *cnt;
 } trav;
 
-/* The both visit's frustum test: inside the frustum, any facing; zz gets z. */
-static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float zmax, float *zz)
-{
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float len = r->len, h0 = r->h0, dh = r->dh;
-    const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
-    uint32_t ok[16];
-#pragma omp simd
-    for (uint32_t i = 0; i < 16; i++) {
-        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
-        float z = Dx * dx + Dy * dy + Dz * dz;
-        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
-        float h = h0 + dh * (z < len ? z : len);
-        ok[i] = (z >= 0.0f) & (z <= zmax) & (ex * ex + ey * ey + ez * ez < h * h) & (i < m);
-        zz[i] = z;
-    }
-    uint32_t mask = 0;
-    for (uint32_t i = 0; i < 16; i++)
-        mask |= ok[i] << i;
-    return mask;
-}
-
 /* Samples [lo, hi); culled: under a culling node that prunes them (only
  * the both visit gets there, for the frustum's lanes). */
 static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
@@ -215,11 +222,11 @@ static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
             float z[16], w[16], iz[16];
-            uint32_t in = frustum16(v->t, b, m, v->r, v->zmax, z), feas = 0;
-            if (!culled)
-                feas = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, iz) : weigh16(v->t, b, m, v->r, 0, w, iz);
-            if (in | feas)
-                v->fnb(v->ctx, b, m, in, z, feas, w, iz);
+            any16 a = {v->zmax, culled, 0, z};
+            uint32_t feas = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, iz, &a)
+                                             : weigh16(v->t, b, m, v->r, 0, w, iz, &a);
+            if (a.mask | feas)
+                v->fnb(v->ctx, b, m, a.mask, z, feas, w, iz);
         }
         return;
     }
@@ -227,7 +234,8 @@ static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
-        uint32_t any = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz) : weigh16(v->t, b, m, v->r, 0, w, zz);
+        uint32_t any =
+            v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz, NULL) : weigh16(v->t, b, m, v->r, 0, w, zz, NULL);
         if (any)
             v->fn(v->ctx, b, m, any, w, zz);
     }

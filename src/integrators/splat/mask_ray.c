@@ -351,7 +351,6 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = x->pw + first;
     int cell[16];
     int32_t zb[16];
-    uint32_t occ[16];
     cells16(x, fb, cell, zb);
     /* candidates: a front sample, not the lane itself, nearer by more
      * than the lane's footprint */
@@ -368,10 +367,34 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
     __mmask16 cm = _mm512_mask_cmpneq_epi32_mask(in, o, _mm512_set1_epi32(-1));
     cm = _mm512_mask_cmpneq_epi32_mask(cm, o, _mm512_add_epi32(lane, _mm512_set1_epi32((int)first)));
     cm = _mm512_mask_cmplt_epi32_mask(cm, zk, _mm512_loadu_si512(zb));
-    _mm512_storeu_si512(occ, o);
-    uint32_t hit = cm;
+    if (!cm)
+        return mask;
+    /* hidden if the sample lies on the far side of the occluder's
+     * tangent plane from the ray's origin (by its footprint); an occluder
+     * whose plane holds the origin (the surface the ray leaves) hides
+     * nothing */
+    const __m512 zero = _mm512_setzero_ps();
+    __m512 nx = _mm512_mask_i32gather_ps(zero, cm, o, t->nrm[0], 4);
+    __m512 ny = _mm512_mask_i32gather_ps(zero, cm, o, t->nrm[1], 4);
+    __m512 nz = _mm512_mask_i32gather_ps(zero, cm, o, t->nrm[2], 4);
+    __m512 qx = _mm512_mask_i32gather_ps(zero, cm, o, t->p[0], 4);
+    __m512 qy = _mm512_mask_i32gather_ps(zero, cm, o, t->p[1], 4);
+    __m512 qz = _mm512_mask_i32gather_ps(zero, cm, o, t->p[2], 4);
+    __m512 pwo = _mm512_mask_i32gather_ps(zero, cm, o, x->pw, 4);
+    __m512 so = _mm512_fmadd_ps(_mm512_sub_ps(_mm512_set1_ps(oz), qz), nz,
+                         _mm512_fmadd_ps(_mm512_sub_ps(_mm512_set1_ps(oy), qy), ny,
+                                         _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(ox), qx), nx)));
+    __m512 sy = _mm512_fmadd_ps(_mm512_sub_ps(_mm512_loadu_ps(pz), qz), nz,
+                                _mm512_fmadd_ps(_mm512_sub_ps(_mm512_loadu_ps(py), qy), ny,
+                                                _mm512_mul_ps(_mm512_sub_ps(_mm512_loadu_ps(px), qx), nx)));
+    __m512 rho = _mm512_loadu_ps(pw);
+    __mmask16 hide = _mm512_mask_cmp_ps_mask(cm, _mm512_abs_ps(so), pwo, _CMP_GT_OQ);
+    __mmask16 pos = _mm512_cmp_ps_mask(so, zero, _CMP_GT_OQ);
+    hide &= (__mmask16)((pos & _mm512_cmp_ps_mask(sy, _mm512_sub_ps(zero, rho), _CMP_LT_OQ)) |
+                        (~pos & _mm512_cmp_ps_mask(sy, rho, _CMP_GT_OQ)));
+    return mask & ~(uint32_t)hide;
 #else
-    uint32_t hit = 0;
+    uint32_t hit = 0, occ[16];
     for (int i = 0; i < 16; i++) {
         if (!(mask >> i & 1u) || cell[i] < 0)
             continue;
@@ -380,7 +403,6 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
         hit |= (uint32_t)((occ[i] != UINT32_MAX) & (occ[i] != first + (uint32_t)i) &
                           ((int32_t)(uint32_t)(key >> 32) < zb[i])) << i;
     }
-#endif
     uint32_t keep = mask;
     for (; hit; hit &= hit - 1) {
         uint32_t i = (uint32_t)__builtin_ctz(hit), o = occ[i];
@@ -394,4 +416,5 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
             keep &= ~(1u << i);
     }
     return keep;
+#endif
 }
