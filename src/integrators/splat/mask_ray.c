@@ -276,6 +276,22 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
     const float *zz = hb->z, *U = x->U, *V = x->V;
     const int g = x->g;
     uint64_t *grid = x->grid;
+    /* lanes nearer than the reach, as their key's distance bits (+ 0: -0
+     * becomes +0, whose bits order with the rest) */
+    uint32_t zk[16], near = 0;
+#if defined(__AVX512F__)
+    __m512i zb = _mm512_castps_si512(_mm512_add_ps(_mm512_loadu_ps(zz), _mm512_setzero_ps()));
+    near = _mm512_mask_cmplt_epi32_mask((__mmask16)hb->mask, zb, _mm512_set1_epi32(x->reach));
+    _mm512_storeu_si512(zk, zb);
+#else
+    for (int i = 0; i < 16; i++) {
+        zk[i] = float_bits(zz[i] + 0.0f);
+        near |= (uint32_t)((int32_t)zk[i] < x->reach) << i;
+    }
+    near &= hb->mask;
+#endif
+    if (!near)
+        return 0;
     const float ics = 0.5f * (float)g;
     const float h0 = r->h0, dh = r->dh, len = r->len;
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
@@ -284,7 +300,7 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
     const float *ax[6];
     for (int c = 0; c < 6; c++)
         ax[c] = x->ax[c] + first;
-    int box[4][16], keep[16];
+    int box[4][16], c0[16], da[16], db[16], kind[16];
     /* the cells each lane covers, 16 at a time (lanes past m are masked) */
 #pragma omp simd
     for (int i = 0; i < 16; i++) {
@@ -293,53 +309,53 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
         /* the surface the ray leaves hides nothing, and in the cells
          * around the ray it would stand in front of what does */
         float so = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
-        keep[i] = fabsf(so) > pw[i];
+        int keep = fabsf(so) > pw[i];
         /* in the kernel's plane: lateral offsets over the radius at z */
         float ih = ics / (h0 + dh * (z < len ? z : len));
         float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g;
         float v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + 0.5f * (float)g;
         /* the patch's ellipse seen along d: its half extents in u and v */
-        float t1 = ax[0][i] * U[0] + ax[1][i] * U[1] + ax[2][i] * U[2], b1 = ax[3][i] * U[0] + ax[4][i] * U[1] + ax[5][i] * U[2];
-        float t2 = ax[0][i] * V[0] + ax[1][i] * V[1] + ax[2][i] * V[2], b2 = ax[3][i] * V[0] + ax[4][i] * V[1] + ax[5][i] * V[2];
-        float fu = sqrtf(t1 * t1 + b1 * b1) * ih, fv = sqrtf(t2 * t2 + b2 * b2) * ih;
+        float t1 = ax[0][i] * U[0] + ax[1][i] * U[1] + ax[2][i] * U[2], s1 = ax[3][i] * U[0] + ax[4][i] * U[1] + ax[5][i] * U[2];
+        float t2 = ax[0][i] * V[0] + ax[1][i] * V[1] + ax[2][i] * V[2], s2 = ax[3][i] * V[0] + ax[4][i] * V[1] + ax[5][i] * V[2];
+        float fu = sqrtf(t1 * t1 + s1 * s1) * ih, fv = sqrtf(t2 * t2 + s2 * s2) * ih;
         /* + 1 so truncation floors; clamped to the grid */
         /* (comparisons, not fminf: the loop stays vectorized) */
         float u0 = u - fu + 1.0f, u1 = u + fu + 1.0f, v0 = v - fv + 1.0f, v1 = v + fv + 1.0f, G = (float)g;
         u0 = u0 > 1.0f ? u0 : 1.0f, u1 = u1 > 0.0f ? u1 : 0.0f, v0 = v0 > 1.0f ? v0 : 1.0f, v1 = v1 > 0.0f ? v1 : 0.0f;
-        box[0][i] = (int)(u0 < G ? u0 : G) - 1;
-        box[1][i] = (int)(u1 < G ? u1 : G) - 1;
-        box[2][i] = (int)(v0 < G ? v0 : G) - 1;
-        box[3][i] = (int)(v1 < G ? v1 : G) - 1;
+        int a0 = (int)(u0 < G ? u0 : G) - 1, a1 = (int)(u1 < G ? u1 : G) - 1;
+        int b0 = (int)(v0 < G ? v0 : G) - 1, b1 = (int)(v1 < G ? v1 : G) - 1;
+        box[0][i] = a0, box[1][i] = a1, box[2][i] = b0, box[3][i] = b1;
+        /* most boxes are at most 2 x 2 cells: their corner cells (a
+         * narrower box repeats some; z-min twice changes nothing) */
+        c0[i] = b0 * g + a0;
+        da[i] = a1 - a0;
+        db[i] = (b1 - b0) * g;
+        int some = keep & (a1 >= a0) & (b1 >= b0);
+        kind[i] = some ? (a1 - a0 <= 1) & (b1 - b0 <= 1) ? 1 : 2 : 0;
     }
-    uint32_t live = 0, n = 0;
-    for (int i = 0; i < 16; i++)
-        live |= (uint32_t)(keep[i] != 0) << i;
-    for (uint32_t mask = hb->mask & live; mask; mask &= mask - 1) {
-        int i = __builtin_ctz(mask);
-        /* + 0: -0 becomes +0, whose bits order with the rest */
-        uint32_t zb = float_bits(zz[i] + 0.0f);
-        if (!((int32_t)zb < x->reach))
-            continue;
-        uint64_t key = (uint64_t)zb << 32 | (first + (uint32_t)i);
-        const int a0 = box[0][i], a1 = box[1][i], b0 = box[2][i], b1 = box[3][i];
-        n++;
-        if (a1 < a0 || b1 < b0)
-            continue;
-        if (a1 - a0 <= 1 && b1 - b0 <= 1) {
-            /* at most 2 x 2 cells, most of them: the 4 corners, a
-             * narrower box repeating some (z-min twice changes nothing) */
-            uint64_t *r0 = grid + b0 * g, *r1 = grid + b1 * g;
-            cell_min(r0 + a0, key);
-            cell_min(r0 + a1, key);
-            cell_min(r1 + a0, key);
-            cell_min(r1 + a1, key);
-            continue;
-        }
-        for (int b = b0; b <= b1; b++)
-            for (int a = a0; a <= a1; a++)
+    uint32_t small = 0, large = 0;
+    for (int i = 0; i < 16; i++) {
+        small |= (uint32_t)(kind[i] == 1) << i;
+        large |= (uint32_t)(kind[i] == 2) << i;
+    }
+    small &= near, large &= near;
+    for (uint32_t m = small; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        uint64_t key = (uint64_t)zk[i] << 32 | (first + (uint32_t)i);
+        uint64_t *c = grid + c0[i];
+        cell_min(c, key);
+        cell_min(c + da[i], key);
+        cell_min(c + db[i], key);
+        cell_min(c + db[i] + da[i], key);
+    }
+    for (uint32_t m = large; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        uint64_t key = (uint64_t)zk[i] << 32 | (first + (uint32_t)i);
+        for (int b = box[2][i]; b <= box[3][i]; b++)
+            for (int a = box[0][i]; a <= box[1][i]; a++)
                 cell_min(grid + b * g + a, key);
     }
-    return n;
+    return (uint32_t)__builtin_popcount(small | large);
 }
 
 uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
