@@ -225,10 +225,11 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
  * bit for bit, and the same culling nodes: their subtrees are still
  * visited for `any`, not weighed). Called where either mask is non-zero;
  * batches come in tree order (parts in order, so a part's batches are
- * contiguous). w and iz are only meaningful on feasible lanes. A feasible
- * sample lies inside the frustum (the leaf test adds conditions to the
- * frustum test), up to rounding at its rim: feasible need not be a
- * subset of any. */
+ * contiguous): the bounding spheres, CDL_SKD_SLABS ignored (they feed the
+ * same samples). w and iz are only meaningful on feasible lanes. The
+ * frustum test is the leaf test's first step, so feasible lanes are a
+ * subset of any up to rounding at the cap's end (which nothing relies
+ * on: a feasible lane outside `any` is just no occluder). */
 typedef void (*cdl_skd_visit_both)(void *ctx, uint32_t first, uint32_t m, uint32_t any, const float *z,
                                    uint32_t feasible, const float *w, const float *iz);
 int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,

@@ -578,7 +578,7 @@ static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int fl
               {0.0f, 0.0f, 0.0f},
               0.0f,
               (flags & CDL_SKD_CULL) != 0,
-              (flags & CDL_SKD_SLABS) != 0,
+              (flags & CDL_SKD_SLABS) && !fnb, /* the slabs go front to back, not in tree order */
               fnb != NULL,
               fn,
               fnb,

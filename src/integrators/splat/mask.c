@@ -419,7 +419,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
     {
         build_count c = {0, 0, 0, 0, 0, 0, 0};
         uint32_t wid = (uint32_t)omp_get_thread_num();
-#pragma omp for schedule(dynamic, 64)
+#pragma omp for schedule(dynamic, 16)
         for (uint32_t k = 0; k < n; k++)
             build_ray(s, wid, k, flags, &c);
 #pragma omp critical(splat_mask_count)
