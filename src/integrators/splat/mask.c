@@ -18,16 +18,22 @@
  * only needs no mask.
  *
  * Cost (issue 29): one traversal per ray, as the report rasterizes
- * "during the ray traversal": a batch of rays at a time, in parallel over
- * the rays, each ray's traversal yields the frustum's samples and the
- * feasible ones (cdl_skd_splat_visit_both); the frustum's are rasterized,
- * the feasible ones filtered against the ray's buffer right away, and the
- * survivors (weights and 1 / z, compressed to their lanes) kept per ray.
- * The batch then splats part by part as without masks: each part replays its rays' kept splats in ray order, so every sample
- * sums its splats in the same order. A cell holds the front sample as
- * one 64-bit key, distance bits over the sample's index (z >= 0: the
- * float's bits order as the float), so z-min with the index's tie-break
- * is one unsigned min and a row of cells one masked SIMD min. */
+ * "during the ray traversal": a batch of SPLAT_MASK_BATCH rays at a time,
+ * in parallel over the rays, each ray's traversal yields the frustum's
+ * samples and the feasible ones (cdl_skd_splat_visit_both: the same
+ * weights bit for bit as the traversal without masks). Most rays need no
+ * buffer (mask_ray.c: one plane in the frustum, or no sample whose plane
+ * has a feasible one behind it); the others rasterize and filter their
+ * feasible samples right away. The survivors (weights and 1 / z, packed
+ * to their lanes) are kept per ray, split by tree part; the batch then
+ * splats part by part as without masks, each part replaying its rays'
+ * kept splats in ray order, so every sample sums its splats in the same
+ * order and the image is the one two traversals gave. A cell holds its
+ * front sample as one 64-bit key, distance bits over the sample's index
+ * (z >= 0: the float's bits order as the float), so z-min with the
+ * index's tie-break is one unsigned min. On the Cornell box (global
+ * light, 250000 photon rays) the kept splats of 4096 rays take about 70
+ * MiB, the buffers 8 KiB per thread. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
