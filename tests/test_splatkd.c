@@ -2,7 +2,9 @@
  * frustum traversal (Algorithm 1), with and without culling nodes, whole
  * or part by part, finds exactly the feasible samples brute force finds,
  * with the same weights; the layout keeps its promises (8-byte nodes,
- * small leaves, culling nodes on coherent normals); parallel photon rays
+ * small leaves, culling nodes on coherent normals); the visibility mask's
+ * one traversal (both visit) feeds exactly what the part-by-part visits
+ * feed, and its frustum lanes hold every feasible one; parallel photon rays
  * onto a plane give the exact irradiance; a sample never receives light
  * from the side it does not show. */
 #include <math.h>
@@ -157,6 +159,120 @@ static void traversal(void)
     free(fl);
 }
 
+/* What a visit fed: sample, weight and 1 / z, bit for bit. */
+typedef struct fed {
+    uint32_t *s, n, cap, last, order_ok, outside, any;
+    float *w, *iz;
+} fed;
+
+static void fed_add(fed *f, uint32_t q, float w, float iz)
+{
+    if (f->n == f->cap) {
+        f->cap = f->cap ? 2 * f->cap : 1024;
+        f->s = realloc(f->s, sizeof *f->s * f->cap);
+        f->w = realloc(f->w, sizeof *f->w * f->cap);
+        f->iz = realloc(f->iz, sizeof *f->iz * f->cap);
+    }
+    f->s[f->n] = q, f->w[f->n] = w, f->iz[f->n] = iz;
+    f->n++;
+}
+
+static void fed_part(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
+{
+    (void)m;
+    for (; mask; mask &= mask - 1) {
+        int i = __builtin_ctz(mask);
+        fed_add(ctx, first + (uint32_t)i, w[i], iz[i]);
+    }
+}
+
+static void fed_both(void *ctx, uint32_t first, uint32_t m, uint32_t any, const float *z, uint32_t feasible,
+                     const float *w, const float *iz)
+{
+    (void)m, (void)z;
+    fed *f = ctx;
+    f->order_ok &= first >= f->last;
+    f->last = first;
+    f->outside += (uint32_t)__builtin_popcount(feasible & ~any);
+    f->any += (uint32_t)__builtin_popcount(any);
+    fed_part(ctx, first, m, feasible, w, iz);
+}
+
+static void sort_fed(fed *f)
+{
+    for (uint32_t i = 1; i < f->n; i++) /* insertion sort: a few hundred, mostly in order */
+        for (uint32_t j = i; j > 0 && f->s[j - 1] > f->s[j]; j--) {
+            uint32_t s = f->s[j];
+            float w = f->w[j], iz = f->iz[j];
+            f->s[j] = f->s[j - 1], f->w[j] = f->w[j - 1], f->iz[j] = f->iz[j - 1];
+            f->s[j - 1] = s, f->w[j - 1] = w, f->iz[j - 1] = iz;
+        }
+}
+
+/* The both visit against the visits part by part, with and without
+ * culling nodes and with the slabs. */
+static void both_visit(void)
+{
+    cdl_rng r;
+    cdl_rng_seed(&r, 11, 3);
+    uint32_t n = 20000;
+    cdl_vec3 *p = malloc(sizeof *p * n), *nr = malloc(sizeof *nr * n);
+    uint8_t *fl = malloc(n);
+    make_samples(&r, n, p, nr, fl);
+    cdl_skd t;
+    cdl_skd_params prm;
+    cdl_skd_params_default(&prm, sqrtf(3.0f));
+    cdl_error err;
+    die_on(cdl_skd_build(&t, p, nr, fl, n, &prm, &err), &err);
+    fed a = {0}, b = {0};
+    uint32_t differ = 0, total = 0, outside = 0, order = 1, culled_any = 0;
+    uint64_t anys = 0;
+    const int flags[3] = {0, CDL_SKD_CULL, CDL_SKD_CULL | CDL_SKD_SLABS};
+    for (int k = 0; k < 600; k++) {
+        cdl_splat_ray ray;
+        ray.o = cdl_v3(1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f);
+        ray.d = rand_dir(&r);
+        ray.on = k % 3 ? cdl_v3(0, 0, 0) : rand_dir(&r);
+        ray.len = 1.5f * cdl_rng_float(&r);
+        ray.h0 = 0.1f * cdl_rng_float(&r);
+        ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
+        ray.cap = k % 3 == 1 ? 0.0f : 4.0f;
+        ray.zmin = k % 3 ? 0.0f : 1e-3f;
+        ray.otol = k % 5 ? 0.0f : 1e-3f;
+        int f = flags[k % 3];
+        cdl_skd_count cnt = {0, 0, 0};
+        a.n = b.n = 0;
+        b.last = 0, b.order_ok = 1, b.outside = 0, b.any = 0;
+        for (uint32_t q = 0; q < t.nparts; q++)
+            cdl_skd_splat_visit(&t, q, &ray, f, fed_part, &a, &cnt);
+        cdl_skd_splat_visit_both(&t, &ray, f, fed_both, &b, &cnt);
+        /* the parts come in order, so both lists are in tree order (not so
+         * the slabs part by part: front to back) */
+        if (f & CDL_SKD_SLABS)
+            sort_fed(&a);
+        differ += a.n != b.n;
+        for (uint32_t i = 0; i < a.n && i < b.n; i++)
+            differ += a.s[i] != b.s[i] || memcmp(&a.w[i], &b.w[i], 4) || memcmp(&a.iz[i], &b.iz[i], 4);
+        total += a.n;
+        outside += b.outside;
+        order &= b.order_ok;
+        anys += b.any;
+        culled_any += (f & CDL_SKD_CULL) && b.any > b.n;
+    }
+    CHECK(differ == 0 && total > 20000 && order,
+          "the both visit feeds what the part-by-part visits feed over 600 rays, bit for bit, in tree order "
+          "(%u feasible samples, %u differ)",
+          total, differ);
+    CHECK(outside == 0 && anys > (uint64_t)total && culled_any > 0,
+          "its frustum lanes (%.2f per feasible sample) hold every feasible one (%u outside)",
+          (double)anys / total, outside);
+    free(a.s), free(a.w), free(a.iz), free(b.s), free(b.w), free(b.iz);
+    cdl_skd_free(&t);
+    free(p);
+    free(nr);
+    free(fl);
+}
+
 /* Expected irradiance of parallel rays at angle theta onto a plane, as a
  * fraction of the exact phi / g^2 cos(theta): rays ending before a sample
  * reach it through the hemispherical cap of Algorithm 2, whose kernel is
@@ -252,6 +368,7 @@ int main(void)
 {
     sheet();
     traversal();
+    both_visit();
     irradiance(0.0f, 0.0f);
     irradiance(0.6f, 0.0f);
     irradiance(0.6f, 4.0f);

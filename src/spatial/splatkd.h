@@ -203,11 +203,7 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 /* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
  * report's traversal) instead of the default bounding-sphere test per
  * node (the same samples, fewer tested). */
-enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_ANY = 4 };
-/* CDL_SKD_ANY: every sample inside the frustum (within h of the ray, 0 <=
- * z up to the cap's reach) whatever its facing, as the occluders of a
- * visibility mask see them: the visit's mask holds them, w is 0 and iz[i]
- * is z itself; culling nodes are not honoured. */
+enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2 };
 
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
@@ -217,9 +213,27 @@ enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_ANY = 4 };
 typedef void (*cdl_skd_visit)(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz);
 typedef struct cdl_skd_count {
     uint64_t tested, nodes;
+    uint64_t weighed; /* of the tested, those given the leaf test (the both visit: not culled) */
 } cdl_skd_count;
 int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
                         void *ctx, cdl_skd_count *cnt);
+/* One traversal of the whole tree for a visibility mask and the splats
+ * it filters: per batch, `any` holds every sample inside the frustum
+ * (within h of the ray, 0 <= z <= the cap's reach) whatever its facing,
+ * with z[i] its distance along the ray, as a mask's occluders; `feasible`,
+ * w and iz what cdl_skd_splat_visit gives the batch (the same leaf test,
+ * bit for bit, and the same culling nodes: their subtrees are still
+ * visited for `any`, not weighed). Called where either mask is non-zero;
+ * batches come in tree order (parts in order, so a part's batches are
+ * contiguous): the bounding spheres, CDL_SKD_SLABS ignored (they feed the
+ * same samples). w and iz are only meaningful on feasible lanes. The
+ * frustum test is the leaf test's first step, so feasible lanes are a
+ * subset of any up to rounding at the cap's end (which nothing relies
+ * on: a feasible lane outside `any` is just no occluder). */
+typedef void (*cdl_skd_visit_both)(void *ctx, uint32_t first, uint32_t m, uint32_t any, const float *z,
+                                   uint32_t feasible, const float *w, const float *iz);
+int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,
+                             cdl_skd_count *cnt);
 /* The leaf test alone (Algorithm 2) for samples [b, b + m), m <= 16, of
  * any arrays laid out as the tree's p, nrm and two (16 floats of padding
  * past the last): w and iz as a visit gets them; returns the mask of

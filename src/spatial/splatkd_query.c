@@ -26,9 +26,19 @@ static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
     return 0;
 }
 
+/* The both visit's frustum test, on the way (see cdl_skd_visit_both):
+ * lanes inside the frustum up to zmax and their z; culled: the leaf test
+ * is not wanted. */
+typedef struct any16 {
+    float zmax;
+    int culled;
+    uint32_t mask;
+    float *z;
+} any16;
+
 /* Algorithm 2's feasibility and weight for up to 16 samples from b:
  * w[i] kernel times cosine (0 where infeasible), zz[i] 1 / z; returns
- * the mask of feasible lanes. `plane` is a constant in each caller;
+ * the mask of feasible lanes; with a, the frustum test too. `plane` is a constant in each caller;
  * cdl_splat_weight is the same test one sample at a time. With AVX-512
  * the 16 lanes are one register and the reciprocals rcp14 with a Newton
  * step (relative error ~1e-7); otherwise a branch-free loop that the
@@ -41,7 +51,7 @@ static inline __m512 rcp_nr(__m512 x)
 }
 
 static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane,
-                               float *w, float *zz)
+                               float *w, float *zz, any16 *a)
 {
     const __m512 zero = _mm512_setzero_ps();
     const __m512 dx = _mm512_set1_ps(r->d.x), dy = _mm512_set1_ps(r->d.y), dz = _mm512_set1_ps(r->d.z);
@@ -62,6 +72,12 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
      * normals are loaded */
     ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
+    if (a) {
+        a->mask = _mm512_mask_cmp_ps_mask(ok, z, _mm512_set1_ps(a->zmax), _CMP_LE_OQ);
+        _mm512_storeu_ps(a->z, z);
+        if (a->culled)
+            return 0;
+    }
     if (!ok)
         return 0;
     __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
@@ -114,8 +130,8 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     return ok;
 }
 #else
-static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
-                        float *zz)
+static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
+                               float *zz, any16 *a)
 {
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
@@ -124,6 +140,9 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
     const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
     const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
     const float *two = t->two + b;
+    const float zmax = a ? a->zmax : 0.0f;
+    float zo[16];
+    int in[16];
 #pragma omp simd
     for (uint32_t i = 0; i < 16; i++) { /* all 16 lanes (the arrays have room): a fixed trip count */
         float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
@@ -137,6 +156,8 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         float r2 = ex * ex + ey * ey + ez * ez;
         float h = h0 + dh * (z < len ? z : len);
         float h2 = h * h, beyond = z - len;
+        in[i] = (z >= 0.0f) & (z <= zmax) & (r2 < h2) & (i < m);
+        zo[i] = z;
         float non = nx[i] * nx0 + ny[i] * ny0 + nz[i] * nz0;
         /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
         int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f) & ((zn >= zmin) | (non >= CDL_SKD_SHEET_COS));
@@ -159,6 +180,14 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         w[i] = ok ? wi : 0.0f;
         zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
+    if (a) {
+        a->mask = 0;
+        for (uint32_t i = 0; i < 16; i++)
+            a->mask |= (uint32_t)in[i] << i;
+        memcpy(a->z, zo, sizeof zo);
+        if (a->culled)
+            return 0;
+    }
     uint32_t mask = 0;
     for (uint32_t i = 0; i < 16; i++)
         mask |= (uint32_t)(w[i] > 0.0f) << i;
@@ -168,7 +197,7 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 
 uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz)
 {
-    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz) : weigh16(t, b, m, r, 0, w, iz);
+    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz, NULL) : weigh16(t, b, m, r, 0, w, iz, NULL);
 }
 
 typedef struct trav {
@@ -176,53 +205,37 @@ typedef struct trav {
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
-    int cull, slabs, any;
+    int cull, slabs, both;
     cdl_skd_visit fn;
+    cdl_skd_visit_both fnb;
     void *ctx;
     cdl_skd_count *cnt;
 } trav;
 
-/* CDL_SKD_ANY's leaf test: inside the frustum, any facing; zz gets z. */
-static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float zmax, float *w,
-                          float *zz)
-{
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float len = r->len, h0 = r->h0, dh = r->dh;
-    const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
-    uint32_t ok[16];
-#pragma omp simd
-    for (uint32_t i = 0; i < 16; i++) {
-        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
-        float z = Dx * dx + Dy * dy + Dz * dz;
-        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
-        float h = h0 + dh * (z < len ? z : len);
-        ok[i] = (z >= 0.0f) & (z <= zmax) & (ex * ex + ey * ey + ez * ez < h * h) & (i < m);
-        zz[i] = z;
-        w[i] = 0.0f;
-    }
-    uint32_t mask = 0;
-    for (uint32_t i = 0; i < 16; i++)
-        mask |= ok[i] << i;
-    return mask;
-}
-
-static void test_range(const trav *v, uint32_t lo, uint32_t hi)
+/* Samples [lo, hi); culled: under a culling node that prunes them (only
+ * the both visit gets there, for the frustum's lanes). */
+static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
 {
     v->cnt->tested += hi - lo;
-    if (v->any) {
+    if (v->both) {
+        v->cnt->weighed += culled ? 0 : hi - lo;
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
-            float w[16], zz[16];
-            uint32_t in = frustum16(v->t, b, m, v->r, v->zmax, w, zz);
-            if (in)
-                v->fn(v->ctx, b, m, in, w, zz);
+            float z[16], w[16], iz[16];
+            any16 a = {v->zmax, culled, 0, z};
+            uint32_t feas = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, iz, &a)
+                                             : weigh16(v->t, b, m, v->r, 0, w, iz, &a);
+            if (a.mask | feas)
+                v->fnb(v->ctx, b, m, a.mask, z, feas, w, iz);
         }
         return;
     }
+    v->cnt->weighed += hi - lo;
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
-        uint32_t any = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz) : weigh16(v->t, b, m, v->r, 0, w, zz);
+        uint32_t any =
+            v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz, NULL) : weigh16(v->t, b, m, v->r, 0, w, zz, NULL);
         if (any)
             v->fn(v->ctx, b, m, any, w, zz);
     }
@@ -249,13 +262,14 @@ static int sphere_reached(const trav *v, uint32_t node)
 }
 
 /* A leaf, empty or culling node: 1 if the traversal goes on to the
- * culling node's child (node + 1). */
-static inline int special_node(const trav *v, cdl_skd_node nd)
+ * culling node's child (node + 1); *culled becomes 1 below a culling
+ * node that prunes in the both visit. */
+static inline int special_node(const trav *v, cdl_skd_node nd, int *culled)
 {
     uint32_t kind = (nd.b >> 2) & 3;
     if (kind == KIND_LEAF) {
         uint32_t lo = nd.b >> 4;
-        test_range(v, lo, lo + nd.a);
+        test_range(v, lo, lo + nd.a, *culled);
         return 0;
     }
     if (kind == KIND_EMPTY)
@@ -266,15 +280,18 @@ static inline int special_node(const trav *v, cdl_skd_node nd)
         float cmax = (float)(nd.b >> 16) / 65535.0f;
         cdl_vec3 n = cdl_oct_decode_raw(nd.a, 16);
         float dv = cdl_dot(v->r->d, n);
-        if (dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n))
-            return 0;
+        if (dv >= 0.0f && dv * dv >= cmax * cmax * cdl_dot(n, n)) {
+            if (!v->both)
+                return 0;
+            *culled = 1;
+        }
     }
     return 1;
 }
 
 /* The default traversal: every node whose bounding sphere the frustum
  * reaches (empty nodes have none). */
-static void traverse_spheres(const trav *v, uint32_t node)
+static void traverse_spheres(const trav *v, uint32_t node, int culled)
 {
     const cdl_skd *t = v->t;
     for (;;) {
@@ -284,14 +301,14 @@ static void traverse_spheres(const trav *v, uint32_t node)
             uint32_t kind = (nd.b >> 2) & 3;
             if (kind != KIND_CULL && (kind == KIND_EMPTY || !sphere_reached(v, node)))
                 return;
-            if (!special_node(v, nd))
+            if (!special_node(v, nd, &culled))
                 return;
             node++;
             continue;
         }
         if (!sphere_reached(v, node))
             return;
-        traverse_spheres(v, node + 1);
+        traverse_spheres(v, node + 1, culled);
         node = nd.b >> 2;
     }
 }
@@ -353,12 +370,16 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
 {
     const cdl_skd *t = v->t;
     cdl_skd_went stack[WIDE_STACK];
-    uint32_t sp = 0;
+    /* the both visit: the stack's entries from `cut` up lie under a
+     * culling node that prunes (UINT32_MAX: none) */
+    uint32_t sp = 0, cut = UINT32_MAX;
     for (;;) {
         v->cnt->nodes++;
         if (e.n == CDL_SKD_WCULL) {
             const cdl_skd_wcull *c = &t->wcull[e.ref];
-            if (!(v->cull && culled(v, c))) {
+            if (!(v->cull && culled(v, c)) || v->both) {
+                if (v->cull && cut == UINT32_MAX && culled(v, c))
+                    cut = sp;
                 e = c->next;
                 continue;
             }
@@ -377,16 +398,18 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
                 continue;
             }
         } else if (e.n != CDL_SKD_WEMPTY) {
-            test_range(v, e.ref, e.ref + e.n);
+            test_range(v, e.ref, e.ref + e.n, cut != UINT32_MAX);
         }
         if (!sp)
             return;
         e = stack[--sp];
+        if (sp < cut)
+            cut = UINT32_MAX;
     }
 }
 
 /* Algorithm 1: node over the ray interval [t0, t1]. */
-static void traverse(const trav *v, uint32_t node, float t0, float t1)
+static void traverse(const trav *v, uint32_t node, float t0, float t1, int culled)
 {
     const cdl_skd *t = v->t;
     for (;;) {
@@ -394,7 +417,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         cdl_skd_node nd = t->nodes[node];
         uint32_t ty = nd.b & 3;
         if (ty == 3) {
-            if (!special_node(v, nd))
+            if (!special_node(v, nd, &culled))
                 return;
             node++;
             continue;
@@ -405,7 +428,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         if (v->d[a] == 0.0f) {
             int go_l = v->o[a] - R1 <= s, go_r = v->o[a] + R1 >= s;
             if (go_l && go_r) {
-                traverse(v, left, t0, t1);
+                traverse(v, left, t0, t1, culled);
                 node = right;
             } else {
                 node = go_l ? left : right;
@@ -418,7 +441,7 @@ static void traverse(const trav *v, uint32_t node, float t0, float t1)
         uint32_t front = v->d[a] > 0.0f ? left : right, back = v->d[a] > 0.0f ? right : left;
         int go_f = t0 <= tb, go_b = t1 >= ta;
         if (go_f && go_b) {
-            traverse(v, front, t0, tb < t1 ? tb : t1);
+            traverse(v, front, t0, tb < t1 ? tb : t1, culled);
             node = back;
             t0 = ta > t0 ? ta : t0;
         } else if (go_f) {
@@ -511,7 +534,8 @@ static void traverse_stop(const stop_trav *s, uint32_t node)
             return;
         }
         if ((nd.b & 3) == 3) {
-            if (kind == KIND_LEAF || !special_node(v, nd))
+            int culled = 0;
+            if (kind == KIND_LEAF || !special_node(v, nd, &culled))
                 return;
             node++;
             continue;
@@ -528,13 +552,13 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, cnt},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, NULL, cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
 
-int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
-                        void *ctx, cdl_skd_count *cnt)
+static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                 cdl_skd_visit_both fnb, void *ctx, cdl_skd_count *cnt)
 {
     if (!t->n)
         return 0;
@@ -553,10 +577,11 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
               {r->d.x, r->d.y, r->d.z},
               {0.0f, 0.0f, 0.0f},
               0.0f,
-              (flags & (CDL_SKD_CULL | CDL_SKD_ANY)) == CDL_SKD_CULL,
-              (flags & CDL_SKD_SLABS) != 0,
-              (flags & CDL_SKD_ANY) != 0,
+              (flags & CDL_SKD_CULL) != 0,
+              (flags & CDL_SKD_SLABS) && !fnb, /* the slabs go front to back, not in tree order */
+              fnb != NULL,
               fn,
+              fnb,
               ctx,
               cnt};
     for (int a = 0; a < 3; a++)
@@ -584,12 +609,24 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return 0;
     cdl_skd_went e = part != UINT32_MAX ? t->wpart[part] : t->wroot;
     if (v.slabs)
-        traverse(&v, root, t0, t1);
+        traverse(&v, root, t0, t1, 0);
     else if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack */
-        traverse_spheres(&v, root);
+        traverse_spheres(&v, root, 0);
     else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
         traverse_wide(&v, e);
     return 0;
+}
+
+int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                        void *ctx, cdl_skd_count *cnt)
+{
+    return visit(t, part, r, flags, fn, NULL, ctx, cnt);
+}
+
+int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,
+                             cdl_skd_count *cnt)
+{
+    return visit(t, UINT32_MAX, r, flags, NULL, fn, ctx, cnt);
 }
 
 static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *z)
@@ -602,7 +639,7 @@ static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const f
 
 int cdl_skd_splat(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_splat_hits *out)
 {
-    cdl_skd_count cnt = {0, 0};
+    cdl_skd_count cnt = {0, 0, 0};
     cdl_skd_splat_visit(t, part, r, flags, append, out, &cnt);
     out->tested += cnt.tested;
     out->nodes += cnt.nodes;

@@ -335,7 +335,7 @@ static int first_round(splat_state *s, splat_cache *c, cdl_error *err)
     uint64_t nodes = 0, splats = 0, tested = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : nodes, splats, tested)
     for (uint32_t part = 0; part < np; part++) {
-        cdl_skd_count cnt = {0, 0};
+        cdl_skd_count cnt = {0, 0, 0};
         list_ctx x;
         memset(&x, 0, sizeof x);
         x.s = s;

@@ -187,7 +187,7 @@ typedef struct ray_ctx {
     splat_state *s;
     splat_terms t;
     uint32_t ray;
-    uint64_t splats, masked, occluded, occl_rays;
+    uint64_t splats, occluded, occl_rays;
 } ray_ctx;
 
 /* The feasible glossy samples of a batch: the ray's light in their maps. */
@@ -220,19 +220,13 @@ static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mas
     }
 }
 
-/* A batch of samples from the tree: every feasible one gets the ray's
- * irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
+/* A batch of samples from the tree (or a ray's kept splats, with the
+ * visibility mask): every feasible one gets the ray's irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
  * perhaps another thread's: masked); glossy ones their map entries too. */
 static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
 {
     ray_ctx *c = ctx;
     splat_state *s = c->s;
-    if (s->mask) {
-        uint32_t seen = splat_mask_filter(s, c->ray, first, mask, iz);
-        c->masked += (uint64_t)__builtin_popcount(mask & ~seen);
-        if (!(mask = seen))
-            return;
-    }
     if (s->occl) {
         uint32_t seen = splat_occl_filter(s, c->t.r, first, mask, iz, &c->occl_rays);
         c->occluded += (uint64_t)__builtin_popcount(mask & ~seen);
@@ -276,6 +270,18 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
         splat_bandwidth(c, first, m, mask, w, iz);
 }
 
+/* With the visibility mask: ray's kept splats, in ray order. */
+static void replay_batch(void *ctx, uint32_t ray, uint32_t first, uint32_t mask, const float *w, const float *iz)
+{
+    ray_ctx *c = ctx;
+    if (ray != c->ray) {
+        c->ray = ray;
+        c->t.r = &c->s->rays.r[ray];
+        c->t.ready = 0;
+    }
+    splat_batch(c, first, 16, mask, w, iz);
+}
+
 void splat_maps_clear(splat_state *s)
 {
     size_t n = (size_t)s->neye + 16;
@@ -292,23 +298,28 @@ void splat_maps_clear(splat_state *s)
 int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
-    uint64_t splats = 0, tested = 0, nodes = 0, masked = 0, occluded = 0, occl_rays = 0;
+    uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
-    /* with visibility masks, a batch of rays at a time: masks first */
+    /* with visibility masks, a batch of rays at a time: one traversal per
+     * ray builds its mask and keeps the splats it lets through, which the
+     * parts then replay */
     uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
         uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
-        if (s->mask)
-            splat_mask_build(s, k0, k1 - k0);
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, masked, occluded, occl_rays)
+        if (s->mask && splat_mask_build(s, k0, k1 - k0, flags))
+            return CDL_ERR_SYSTEM;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, occluded, occl_rays)
         for (uint32_t part = 0; part < s->tree.nparts; part++) {
-            cdl_skd_count cnt = {0, 0};
+            cdl_skd_count cnt = {0, 0, 0};
             ray_ctx c;
             c.s = s;
-            c.splats = c.masked = c.occluded = c.occl_rays = 0;
-            for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
+            c.ray = UINT32_MAX;
+            c.splats = c.occluded = c.occl_rays = 0;
+            if (s->mask)
+                splat_mask_replay(s, part, replay_batch, &c);
+            for (uint32_t k = k0; k < k1 && !s->mask && !cdl_cancelled(s->cancel); k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
                 cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;
@@ -317,7 +328,6 @@ int splat_maps_splat(splat_state *s)
                 cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
             }
             splats += c.splats;
-            masked += c.masked;
             occluded += c.occluded;
             occl_rays += c.occl_rays;
             tested += cnt.tested;
@@ -325,7 +335,6 @@ int splat_maps_splat(splat_state *s)
         }
     }
     s->st.splats += splats;
-    s->st.masked += masked;
     s->st.occluded += occluded;
     s->st.occl_rays += occl_rays;
     s->st.tested += tested;

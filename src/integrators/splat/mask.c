@@ -15,200 +15,138 @@
  * surface never shadows its own neighbours. Only occluders the camera sees
  * count (they must be eye samples), as the report says; the surface the
  * ray leaves is no occluder, and a frustum holding one plane's samples
- * only needs no mask. Masks are built a batch of rays at a time,
- * each ray on its own (deterministic), then the batch splats part by part
- * as without them. */
+ * only needs no mask.
+ *
+ * Cost (issue 29): one traversal per ray, as the report rasterizes
+ * "during the ray traversal": a batch of SPLAT_MASK_BATCH rays at a time,
+ * in parallel over the rays, each ray's traversal yields the frustum's
+ * samples and the feasible ones (cdl_skd_splat_visit_both: the same
+ * weights bit for bit as the traversal without masks). Most rays need no
+ * buffer (mask_ray.c: one plane in the frustum, or no sample whose plane
+ * has a feasible one behind it); the others rasterize and filter their
+ * feasible samples right away. The survivors (weights and 1 / z, packed
+ * to their lanes) are kept per ray, split by tree part; the batch then
+ * splats part by part as without masks, each part replaying its rays'
+ * kept splats in ray order, so every sample sums its splats in the same
+ * order and the image is the one two traversals gave. A cell holds its
+ * front sample as one 64-bit key, distance bits over the sample's index
+ * (z >= 0: the float's bits order as the float), so z-min with the
+ * index's tie-break is one unsigned min. On the Cornell box (global
+ * light, 250000 photon rays) the kept splats of 4096 rays take about 70
+ * MiB, the buffers 8 KiB per thread. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+#include <omp.h>
 
 #include "core/grow.h"
 #include "integrators/splat/mask.h"
+#include "integrators/splat/mask_ray.h"
 
-#define MASK_G 32
-#define FRAME 7 /* floats per ray: U, V, g (cells over the kernel's unit disc, each 2 / g wide) */
+/* A kept batch: its lanes' w then 1 / z from val[off], packed. */
+typedef struct mask_rec {
+    uint32_t first, keep, off;
+} mask_rec;
+/* A ray's kept batches in one part: rec[rec0, rec0 + n) of a worker. */
+typedef struct mask_seg {
+    uint32_t part, rec0, n;
+} mask_seg;
+typedef struct mask_pentry {
+    uint32_t w, ray, rec0, n; /* worker, ray in the batch, its records */
+} mask_pentry;
+
+/* Per thread: what one ray's traversal holds, the buffer, and the kept
+ * splats of the batch's rays it took. */
+typedef struct mask_worker {
+    mask_held *held;
+    mask_feas *feas;
+    mask_rec *rec;
+    float *val;
+    mask_seg *seg;
+    uint64_t *grid; /* MASK_G^2 cells: distance bits << 32 | sample, UINT64_MAX empty */
+    uint32_t nh, caph, nf, capf, nrec, caprec, nval, capval, nseg, capseg;
+    int oom;
+} mask_worker;
 
 struct splat_mask {
     uint32_t first;     /* the batch's first ray */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
     float *pw;          /* per eye sample (tree order) its footprint, contiguous for the leaf loops */
-    float *ax[6];       /* and the semi-axes of the surface patch it stands for (see rasterize) */
+    float *ax[6];       /* and the semi-axes of the surface patch it stands for (see prepare) */
     uint32_t npw;
-    uint32_t *occ;      /* per ray: MASK_G^2 cells, the front sample or UINT32_MAX */
-    float *zmin;        /* its distance along the ray */
-    float *frame;       /* per ray: U, V (perpendicular to d), the grid's side g (0: no mask) */
+    float scale;        /* the largest coordinate of the samples' box */
+    mask_worker *w;
+    int nw;
+    uint32_t *rth;      /* per ray of the batch: the worker that took it, */
+    uint32_t *rseg0, *rnseg; /* its segments */
+    uint32_t *pstart, *pcur, npart; /* per part: its entries in plist, in ray order */
+    mask_pentry *plist;
+    uint32_t cappl;
 };
 
 int splat_mask_alloc(splat_state *s, cdl_error *err)
 {
-    const size_t batch = SPLAT_MASK_BATCH;
     if (s->mask)
         return 0;
     splat_mask *m = s->mask = calloc(1, sizeof *m);
     if (m) {
-        m->occ = malloc(sizeof *m->occ * batch * MASK_G * MASK_G);
-        m->zmin = malloc(sizeof *m->zmin * batch * MASK_G * MASK_G);
-        m->frame = malloc(sizeof *m->frame * batch * FRAME);
+        m->rth = malloc(sizeof *m->rth * SPLAT_MASK_BATCH);
+        m->rseg0 = malloc(sizeof *m->rseg0 * SPLAT_MASK_BATCH);
+        m->rnseg = malloc(sizeof *m->rnseg * SPLAT_MASK_BATCH);
     }
-    if (!m || !m->occ || !m->zmin || !m->frame)
+    if (!m || !m->rth || !m->rseg0 || !m->rnseg)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the visibility masks");
     return 0;
 }
 
+static void worker_free(mask_worker *w)
+{
+    free(w->held);
+    free(w->feas);
+    free(w->rec);
+    free(w->val);
+    free(w->seg);
+    free(w->grid);
+}
+
 void splat_mask_free(splat_state *s)
 {
-    if (!s->mask)
+    splat_mask *m = s->mask;
+    if (!m)
         return;
-    free(s->mask->occ);
-    free(s->mask->zmin);
-    free(s->mask->frame);
-    free(s->mask->pw);
+    for (int i = 0; i < m->nw; i++)
+        worker_free(&m->w[i]);
+    free(m->w);
+    free(m->rth);
+    free(m->rseg0);
+    free(m->rnseg);
+    free(m->pstart);
+    free(m->pcur);
+    free(m->plist);
+    free(m->pw);
     for (int c = 0; c < 6; c++)
-        free(s->mask->ax[c]);
-    free(s->mask);
+        free(m->ax[c]);
+    free(m);
     s->mask = NULL;
 }
 
 size_t splat_mask_bytes(const splat_state *s)
 {
-    return s->mask ? (size_t)SPLAT_MASK_BATCH * (MASK_G * MASK_G * 8 + FRAME * sizeof(float)) +
-                         7 * sizeof(float) * s->mask->npw
-                   : 0;
-}
-
-typedef struct build_ctx {
-    const splat_state *s;
-    const cdl_photon_ray *r;
-    const float *fr;
-    uint32_t *occ;
-    float *zmin;
-    const float *pw, *const *ax;
-    uint64_t n; /* samples rasterized */
-} build_ctx;
-
-/* The frustum's samples of one ray, kept a leaf batch at a time until it
- * is known whether they lie on more than one plane (per thread). */
-typedef struct held {
-    uint32_t first, mask;
-    float zz[16];
-} held;
-
-typedef struct hold_ctx {
-    const splat_state *s;
-    const cdl_photon_ray *r;
-    held *b;
-    uint32_t n, cap;
-    int oom;
-} hold_ctx;
-
-static void hold(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *zz)
-{
-    (void)m, (void)w;
-    hold_ctx *h = ctx;
-    if (h->oom)
-        return;
-    if (cdl_grow((void **)&h->b, &h->cap, h->n + 1, sizeof *h->b)) {
-        h->oom = 1;
-        return;
+    const splat_mask *m = s->mask;
+    if (!m)
+        return 0;
+    size_t b = (size_t)SPLAT_MASK_BATCH * 12 + 7 * sizeof(float) * (size_t)m->npw +
+               (size_t)m->cappl * sizeof(mask_pentry) + (size_t)(2 * m->npart + 1) * sizeof(uint32_t);
+    for (int i = 0; i < m->nw; i++) {
+        const mask_worker *w = &m->w[i];
+        b += (size_t)w->caph * sizeof(mask_held) + (size_t)w->capf * sizeof(mask_feas) +
+             (size_t)w->caprec * sizeof(mask_rec) + (size_t)w->capval * sizeof(float) +
+             (size_t)w->capseg * sizeof(mask_seg) + (w->grid ? MASK_G * MASK_G * sizeof(uint64_t) : 0);
     }
-    held *e = &h->b[h->n++];
-    e->first = first;
-    e->mask = mask;
-    memcpy(e->zz, zz, sizeof e->zz);
-}
-
-/* Whether the held samples that can hide anything (not on the surface the
- * ray leaves) lie on one plane: within a quarter of the smallest footprint
- * of the first one's plane, normals within 0.1 degree. No sample of a
- * plane hides another (the filter's test needs one behind another's
- * tangent plane by its footprint), so such a ray needs no mask. */
-static int one_plane(const hold_ctx *h)
-{
-    const cdl_skd *t = &h->s->tree;
-    const float *pw = h->s->mask->pw;
-    const cdl_vec3 o = h->r->o;
-    int have = 0, flat = 1;
-    float p0[3] = {0, 0, 0}, n0[3] = {0, 0, 0}, dmax = 0.0f, pmin = INFINITY;
-    for (uint32_t k = 0; k < h->n && flat; k++)
-        for (uint32_t mask = h->b[k].mask; mask; mask &= mask - 1) {
-            uint32_t q = h->b[k].first + (uint32_t)__builtin_ctz(mask);
-            float p[3] = {t->p[0][q], t->p[1][q], t->p[2][q]}, n[3] = {t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]};
-            float so = (p[0] - o.x) * n[0] + (p[1] - o.y) * n[1] + (p[2] - o.z) * n[2];
-            if (!(fabsf(so) > pw[q]))
-                continue; /* as rasterize: the origin's surface */
-            if (!have) {
-                memcpy(p0, p, sizeof p0);
-                memcpy(n0, n, sizeof n0);
-                have = 1;
-            }
-            float d = fabsf((p[0] - p0[0]) * n0[0] + (p[1] - p0[1]) * n0[1] + (p[2] - p0[2]) * n0[2]);
-            dmax = d > dmax ? d : dmax;
-            pmin = pw[q] < pmin ? pw[q] : pmin;
-            if (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2] < 0.9999985f || dmax > 0.25f * pmin) {
-                flat = 0;
-                break;
-            }
-        }
-    return flat;
-}
-
-static void rasterize(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *zz)
-{
-    (void)m, (void)w;
-    build_ctx *x = ctx;
-    const cdl_skd *t = &x->s->tree;
-    const float *U = x->fr, *V = x->fr + 3, ics = 0.5f * x->fr[6];
-    const float h0 = x->r->h0, dh = x->r->dh, len = x->r->len;
-    const int g = (int)x->fr[6];
-    const float ox = x->r->o.x, oy = x->r->o.y, oz = x->r->o.z, dx = x->r->d.x, dy = x->r->d.y, dz = x->r->d.z;
-    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
-    const float *nx = t->nrm[0] + first, *ny = t->nrm[1] + first, *nz = t->nrm[2] + first, *pw = x->pw + first;
-    const float *ax[6];
-    for (int c = 0; c < 6; c++)
-        ax[c] = x->ax[c] + first;
-    int box[4][16], keep[16];
-    x->n += (uint64_t)__builtin_popcount(mask);
-    /* the cells each lane covers, 16 at a time (lanes past m are masked) */
-#pragma omp simd
-    for (int i = 0; i < 16; i++) {
-        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz, z = zz[i];
-        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
-        /* the surface the ray leaves hides nothing, and in the cells
-         * around the ray it would stand in front of what does */
-        float so = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
-        keep[i] = fabsf(so) > pw[i];
-        /* in the kernel's plane: lateral offsets over the radius at z */
-        float ih = ics / (h0 + dh * (z < len ? z : len));
-        float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g;
-        float v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + 0.5f * (float)g;
-        /* the patch's ellipse seen along d: its half extents in u and v */
-        float t1 = ax[0][i] * U[0] + ax[1][i] * U[1] + ax[2][i] * U[2], b1 = ax[3][i] * U[0] + ax[4][i] * U[1] + ax[5][i] * U[2];
-        float t2 = ax[0][i] * V[0] + ax[1][i] * V[1] + ax[2][i] * V[2], b2 = ax[3][i] * V[0] + ax[4][i] * V[1] + ax[5][i] * V[2];
-        float fu = sqrtf(t1 * t1 + b1 * b1) * ih, fv = sqrtf(t2 * t2 + b2 * b2) * ih;
-        /* + 1 so truncation floors; clamped to the grid */
-        /* (comparisons, not fminf: the loop stays vectorized) */
-        float u0 = u - fu + 1.0f, u1 = u + fu + 1.0f, v0 = v - fv + 1.0f, v1 = v + fv + 1.0f, G = (float)g;
-        u0 = u0 > 1.0f ? u0 : 1.0f, u1 = u1 > 0.0f ? u1 : 0.0f, v0 = v0 > 1.0f ? v0 : 1.0f, v1 = v1 > 0.0f ? v1 : 0.0f;
-        box[0][i] = (int)(u0 < G ? u0 : G) - 1;
-        box[1][i] = (int)(u1 < G ? u1 : G) - 1;
-        box[2][i] = (int)(v0 < G ? v0 : G) - 1;
-        box[3][i] = (int)(v1 < G ? v1 : G) - 1;
-    }
-    for (; mask; mask &= mask - 1) {
-        int i = __builtin_ctz(mask);
-        if (!keep[i])
-            continue;
-        uint32_t q = first + (uint32_t)i;
-        float z = zz[i];
-        for (int b = box[2][i]; b <= box[3][i]; b++)
-            for (int a = box[0][i]; a <= box[1][i]; a++) {
-                int c = b * g + a;
-                if (z < x->zmin[c] || (z == x->zmin[c] && q < x->occ[c])) {
-                    x->zmin[c] = z;
-                    x->occ[c] = q;
-                }
-            }
-    }
+    return b;
 }
 
 static int cmp_float(const void *a, const void *b)
@@ -254,6 +192,9 @@ int splat_mask_prepare(splat_state *s)
     }
     uint32_t n = s->tree.n < 4096 ? s->tree.n : 4096, step = n ? s->tree.n / n : 1;
     float *f = malloc(sizeof *f * (n ? n : 1));
+    m->scale = 0.0f;
+    for (int a = 0; a < 3; a++)
+        m->scale = fmaxf(m->scale, fmaxf(fabsf(s->tree.bmin[a]), fabsf(s->tree.bmax[a])));
     m->rho = 0.0f; /* without memory: the full grid */
     if (!f)
         return 0;
@@ -265,108 +206,262 @@ int splat_mask_prepare(splat_state *s)
     return 0;
 }
 
-int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
+/* The traversal's batches: the frustum's (occluders) and the feasible
+ * ones, held until the ray's buffer is known. */
+static void collect(void *ctx, uint32_t first, uint32_t m, uint32_t any, const float *z, uint32_t feasible,
+                    const float *w, const float *iz)
+{
+    (void)m;
+    mask_worker *x = ctx;
+    if (any) {
+        if (cdl_grow((void **)&x->held, &x->caph, x->nh + 1, sizeof *x->held)) {
+            x->oom = 1;
+            return;
+        }
+        mask_held *e = &x->held[x->nh++];
+        e->first = first;
+        e->mask = any;
+        memcpy(e->z, z, sizeof e->z);
+    }
+    if (feasible) {
+        if (cdl_grow((void **)&x->feas, &x->capf, x->nf + 1, sizeof *x->feas)) {
+            x->oom = 1;
+            return;
+        }
+        mask_feas *e = &x->feas[x->nf++];
+        e->first = first;
+        e->mask = feasible;
+        memcpy(e->w, w, sizeof e->w);
+        memcpy(e->iz, iz, sizeof e->iz);
+    }
+}
+
+/* Packs the kept lanes' w and 1 / z at val (2 popcount(keep) floats). */
+static inline void pack(float *val, uint32_t keep, const float *w, const float *iz)
+{
+#if defined(__AVX512F__)
+    const __mmask16 k = (__mmask16)keep;
+    const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
+    const int n = __builtin_popcount(keep);
+    _mm512_mask_storeu_ps(val, lo, _mm512_maskz_compress_ps(k, _mm512_loadu_ps(w)));
+    _mm512_mask_storeu_ps(val + n, lo, _mm512_maskz_compress_ps(k, _mm512_loadu_ps(iz)));
+#else
+    uint32_t n = (uint32_t)__builtin_popcount(keep), j = 0;
+    for (; keep; keep &= keep - 1, j++) {
+        int i = __builtin_ctz(keep);
+        val[j] = w[i];
+        val[n + j] = iz[i];
+    }
+#endif
+}
+
+/* The inverse: 16 lanes, 0 where not kept. */
+static inline void unpack(const float *val, uint32_t keep, float *w, float *iz)
+{
+#if defined(__AVX512F__)
+    const __mmask16 k = (__mmask16)keep;
+    const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
+    const int n = __builtin_popcount(keep);
+    _mm512_storeu_ps(w, _mm512_maskz_expand_ps(k, _mm512_maskz_loadu_ps(lo, val)));
+    _mm512_storeu_ps(iz, _mm512_maskz_expand_ps(k, _mm512_maskz_loadu_ps(lo, val + n)));
+#else
+    uint32_t n = (uint32_t)__builtin_popcount(keep), j = 0;
+    for (int i = 0; i < 16; i++) {
+        int in = (int)(keep >> i & 1u);
+        w[i] = in ? val[j] : 0.0f;
+        iz[i] = in ? val[n + j] : 0.0f;
+        j += (uint32_t)in;
+    }
+#endif
+}
+
+typedef struct build_count {
+    uint64_t tested, weighed, nodes, rasterized, masks, buffers, masked;
+} build_count;
+
+/* Ray k of the batch on worker wid: one traversal, its mask if the
+ * frustum holds more than one plane, and its surviving splats kept. */
+static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build_count *bc)
 {
     splat_mask *m = s->mask;
-    m->first = first;
-    uint64_t tested = 0, rasterized = 0, masks = 0;
-#pragma omp parallel reduction(+ : tested, rasterized, masks)
-    {
-    hold_ctx h = {s, NULL, NULL, 0, 0, 0};
-#pragma omp for schedule(dynamic, 64)
-    for (uint32_t k = 0; k < n; k++) {
-        const cdl_photon_ray *r = &s->rays.r[first + k];
-        float *fr = m->frame + (size_t)k * FRAME;
-        cdl_frame f = cdl_frame_from(r->d);
-        float hmax = r->h0 + r->dh * r->len;
-        int g = MASK_G;
-        if (2.0f * hmax < g * m->rho)
-            g = (int)ceilf(2.0f * hmax / m->rho);
-        g = g < 1 ? 1 : g;
-        fr[0] = f.t.x, fr[1] = f.t.y, fr[2] = f.t.z;
-        fr[3] = f.b.x, fr[4] = f.b.y, fr[5] = f.b.z;
-        fr[6] = 0.0f; /* no mask unless the frustum holds more than one plane */
-        if (!(hmax > 0.0f))
-            continue;
-        cdl_splat_ray sr = splat_ray_of(s, r);
-        cdl_skd_count cnt = {0, 0};
-        h.r = r;
-        h.n = 0;
-        h.oom = 0;
-        cdl_skd_splat_visit(&s->tree, UINT32_MAX, &sr, CDL_SKD_ANY, hold, &h, &cnt);
-        tested += cnt.tested;
-        if (!h.oom && one_plane(&h))
-            continue;
-        fr[6] = (float)g;
-        masks++;
-        uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
-        float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
-        for (int c = 0; c < g * g; c++) {
-            occ[c] = UINT32_MAX;
-            zmin[c] = INFINITY;
+    mask_worker *x = &m->w[wid];
+    const cdl_photon_ray *r = &s->rays.r[m->first + k];
+    cdl_splat_ray sr = splat_ray_of(s, r);
+    cdl_skd_count cnt = {0, 0, 0};
+    x->nh = x->nf = 0;
+    cdl_skd_splat_visit_both(&s->tree, &sr, flags, collect, x, &cnt);
+    bc->tested += cnt.tested;
+    bc->weighed += cnt.weighed;
+    bc->nodes += cnt.nodes;
+    m->rth[k] = wid;
+    m->rseg0[k] = x->nseg;
+    m->rnseg[k] = 0;
+    if (x->oom)
+        return;
+    cdl_frame f = cdl_frame_from(r->d);
+    float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
+    mask_ray mr = {&s->tree, r, m->pw, (const float *const *)m->ax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
+                   /* ~10x the rounding of a plane offset at the coordinates' scale */
+                   1e-5f * big, 0, INT32_MIN, x->grid};
+    float hmax = r->h0 + r->dh * r->len;
+    /* a mask if the frustum holds more than one plane, a buffer if one
+     * of them may hide a feasible sample */
+    if (hmax > 0.0f && x->nf && !splat_mask_one_plane(&mr, x->held, x->nh)) {
+        bc->masks++;
+        splat_mask_reach(&mr, x->feas, x->nf);
+        if (splat_mask_may_hide(&mr, x->held, x->nh, x->feas, x->nf)) {
+            bc->buffers++;
+            int g = MASK_G;
+            if (2.0f * hmax < (float)g * m->rho)
+                g = (int)ceilf(2.0f * hmax / m->rho);
+            mr.g = g < 1 ? 1 : g;
+            for (int c = 0; c < mr.g * mr.g; c++)
+                x->grid[c] = UINT64_MAX;
+            for (uint32_t b = 0; b < x->nh; b++)
+                bc->rasterized += splat_mask_rasterize(&mr, &x->held[b]);
         }
-        build_ctx x = {s, r, fr, occ, zmin, m->pw, (const float *const *)m->ax, 0};
-        if (h.oom) /* no memory to hold them: traverse again */
-            cdl_skd_splat_visit(&s->tree, UINT32_MAX, &sr, CDL_SKD_ANY, rasterize, &x, &cnt);
-        else
-            for (uint32_t b = 0; b < h.n; b++)
-                rasterize(&x, h.b[b].first, 16, h.b[b].mask, NULL, h.b[b].zz);
-        rasterized += x.n;
     }
-    free(h.b);
+    const cdl_skd_part *parts = s->tree.parts;
+    const uint32_t np = s->tree.nparts;
+    uint32_t p = 0, cur = UINT32_MAX;
+    for (uint32_t j = 0; j < x->nf; j++) {
+        const mask_feas *fb = &x->feas[j];
+        uint32_t keep = mr.g ? splat_mask_filter(&mr, fb) : fb->mask;
+        bc->masked += (uint64_t)__builtin_popcount(fb->mask & ~keep);
+        if (!keep)
+            continue;
+        while (p + 1 < np && fb->first >= parts[p].hi)
+            p++;
+        uint32_t nv = 2 * (uint32_t)__builtin_popcount(keep);
+        if (cdl_grow((void **)&x->rec, &x->caprec, x->nrec + 1, sizeof *x->rec) ||
+            cdl_grow((void **)&x->val, &x->capval, x->nval + nv, sizeof *x->val)) {
+            x->oom = 1;
+            return;
+        }
+        if (cur == UINT32_MAX || x->seg[cur].part != p) {
+            if (cdl_grow((void **)&x->seg, &x->capseg, x->nseg + 1, sizeof *x->seg)) {
+                x->oom = 1;
+                return;
+            }
+            cur = x->nseg++;
+            x->seg[cur] = (mask_seg){p, x->nrec, 0};
+            m->rnseg[k]++;
+        }
+        x->rec[x->nrec++] = (mask_rec){fb->first, keep, x->nval};
+        pack(x->val + x->nval, keep, fb->w, fb->iz);
+        x->nval += nv;
+        x->seg[cur].n++;
     }
-    s->st.mask_tested += tested;
-    s->st.rasterized += rasterized;
-    s->st.mask_rays += masks;
+}
+
+/* Workers for every thread, each with its buffer; their kept splats
+ * emptied for a new batch. */
+static int workers(splat_mask *m)
+{
+    int nth = omp_get_max_threads();
+    if (nth > m->nw) {
+        mask_worker *w = realloc(m->w, sizeof *w * (size_t)nth);
+        if (!w)
+            return -1;
+        memset(w + m->nw, 0, sizeof *w * (size_t)(nth - m->nw));
+        m->w = w;
+        m->nw = nth;
+    }
+    for (int i = 0; i < m->nw; i++) {
+        mask_worker *w = &m->w[i];
+        if (!w->grid && !(w->grid = malloc(sizeof *w->grid * MASK_G * MASK_G)))
+            return -1;
+        w->nrec = w->nval = w->nseg = 0;
+        w->oom = 0;
+    }
     return 0;
 }
 
-uint32_t splat_mask_filter(const splat_state *s, uint32_t ray, uint32_t first, uint32_t mask, const float *iz)
+/* Every part's entries, ray by ray (a counting sort of the segments). */
+static int by_part(splat_mask *m, uint32_t nparts, uint32_t n)
+{
+    if (m->npart < nparts || !m->pstart) {
+        free(m->pstart);
+        free(m->pcur);
+        m->pstart = malloc(sizeof *m->pstart * ((size_t)nparts + 1));
+        m->pcur = malloc(sizeof *m->pcur * ((size_t)nparts + 1));
+        m->npart = nparts;
+        if (!m->pstart || !m->pcur) {
+            m->npart = 0;
+            return -1;
+        }
+    }
+    memset(m->pcur, 0, sizeof *m->pcur * ((size_t)nparts + 1));
+    uint32_t total = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        const mask_seg *sg = m->w[m->rth[k]].seg + m->rseg0[k];
+        for (uint32_t j = 0; j < m->rnseg[k]; j++)
+            m->pcur[sg[j].part]++;
+        total += m->rnseg[k];
+    }
+    if (cdl_grow((void **)&m->plist, &m->cappl, total, sizeof *m->plist))
+        return -1;
+    for (uint32_t p = 0, at = 0; p <= nparts; p++) {
+        uint32_t c = p < nparts ? m->pcur[p] : 0;
+        m->pstart[p] = m->pcur[p] = at;
+        at += c;
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        const mask_seg *sg = m->w[m->rth[k]].seg + m->rseg0[k];
+        for (uint32_t j = 0; j < m->rnseg[k]; j++)
+            m->plist[m->pcur[sg[j].part]++] = (mask_pentry){m->rth[k], k, sg[j].rec0, sg[j].n};
+    }
+    return 0;
+}
+
+int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
+{
+    splat_mask *m = s->mask;
+    m->first = first;
+    if (workers(m))
+        return CDL_ERR_SYSTEM;
+    build_count bc = {0, 0, 0, 0, 0, 0, 0};
+#pragma omp parallel
+    {
+        build_count c = {0, 0, 0, 0, 0, 0, 0};
+        uint32_t wid = (uint32_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 16)
+        for (uint32_t k = 0; k < n; k++)
+            build_ray(s, wid, k, flags, &c);
+#pragma omp critical(splat_mask_count)
+        {
+            bc.tested += c.tested, bc.weighed += c.weighed, bc.nodes += c.nodes;
+            bc.rasterized += c.rasterized, bc.masks += c.masks, bc.buffers += c.buffers, bc.masked += c.masked;
+        }
+    }
+    for (int i = 0; i < m->nw; i++)
+        if (m->w[i].oom)
+            return CDL_ERR_SYSTEM;
+    if (by_part(m, s->tree.nparts, n))
+        return CDL_ERR_SYSTEM;
+    s->st.mask_tested += bc.tested;
+    s->st.tested += bc.weighed;
+    s->st.nodes += bc.nodes;
+    s->st.rasterized += bc.rasterized;
+    s->st.mask_rays += bc.masks;
+    s->st.mask_buffers += bc.buffers;
+    s->st.masked += bc.masked;
+    return 0;
+}
+
+void splat_mask_replay(const splat_state *s, uint32_t part, splat_mask_fn fn, void *ctx)
 {
     const splat_mask *m = s->mask;
-    const cdl_skd *t = &s->tree;
-    const cdl_photon_ray *r = &s->rays.r[ray];
-    uint32_t k = ray - m->first;
-    const float *fr = m->frame + (size_t)k * FRAME, *U = fr, *V = fr + 3;
-    const int g = (int)fr[6];
-    if (!g)
-        return mask; /* one plane in the frustum: nothing hidden */
-    const uint32_t *occ = m->occ + (size_t)k * MASK_G * MASK_G;
-    const float *zmin = m->zmin + (size_t)k * MASK_G * MASK_G;
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float h0 = r->h0, dh = r->dh, len = r->len, ics = 0.5f * (float)g, half = ics;
-    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
-    int cell[16];
-    float zz[16];
-    /* each lane's cell, 16 at a time (-1: outside the grid) */
-#pragma omp simd
-    for (int i = 0; i < 16; i++) {
-        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
-        float ex = px[i] - ox - z * dx, ey = py[i] - oy - z * dy, ez = pz[i] - oz - z * dz;
-        float ih = ics / (h0 + dh * (z < len ? z : len));
-        float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + half, v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + half;
-        int in = u >= 0.0f && v >= 0.0f && u < (float)g && v < (float)g;
-        cell[i] = in ? (int)v * g + (int)u : -1;
-        zz[i] = z;
+    if (part >= m->npart)
+        return;
+    for (uint32_t e = m->pstart[part]; e < m->pstart[part + 1]; e++) {
+        const mask_pentry *pe = &m->plist[e];
+        const mask_worker *x = &m->w[pe->w];
+        for (uint32_t j = pe->rec0; j < pe->rec0 + pe->n; j++) {
+            const mask_rec *rc = &x->rec[j];
+            float w[16], iz[16];
+            unpack(x->val + rc->off, rc->keep, w, iz);
+            fn(ctx, m->first + pe->ray, rc->first, rc->keep, w, iz);
+        }
     }
-    uint32_t keep = mask;
-    for (; mask; mask &= mask - 1) {
-        uint32_t i = (uint32_t)__builtin_ctz(mask), q = first + i;
-        if (cell[i] < 0)
-            continue;
-        uint32_t o = occ[cell[i]];
-        float rho = m->pw[q];
-        if (o == UINT32_MAX || o == q || !(zmin[cell[i]] < zz[i] - rho))
-            continue;
-        /* hidden if the sample lies on the far side of the occluder's
-         * tangent plane from the ray's origin; an occluder whose plane
-         * holds the origin (the surface the ray leaves) hides nothing */
-        float nx = t->nrm[0][o], ny = t->nrm[1][o], nz = t->nrm[2][o];
-        float so = (ox - t->p[0][o]) * nx + (oy - t->p[1][o]) * ny + (oz - t->p[2][o]) * nz;
-        float sy = (px[i] - t->p[0][o]) * nx + (py[i] - t->p[1][o]) * ny + (pz[i] - t->p[2][o]) * nz;
-        float rho_o = m->pw[o];
-        if (fabsf(so) > rho_o && (so > 0.0f ? sy < -rho : sy > rho))
-            keep &= ~(1u << i);
-    }
-    return keep;
 }
