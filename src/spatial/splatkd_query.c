@@ -40,22 +40,50 @@ static inline __m512 rcp_nr(__m512 x)
     return _mm512_mul_ps(r, _mm512_fnmadd_ps(x, r, _mm512_set1_ps(2.0f)));
 }
 
-static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane,
-                               float *w, float *zz)
+/* The ray's numbers broadcast once for a run of leaf tests (a call per
+ * batch would reload them: the stores to w may alias the ray). */
+typedef struct ray16 {
+    __m512 ox, oy, oz, dx, dy, dz, nx, ny, nz, len, h0, dh, zmin, otol, cap, xlen;
+    int otol_on;
+} ray16;
+
+static inline void ray16_of(ray16 *L, const cdl_splat_ray *r)
+{
+    L->ox = _mm512_set1_ps(r->o.x), L->oy = _mm512_set1_ps(r->o.y), L->oz = _mm512_set1_ps(r->o.z);
+    L->dx = _mm512_set1_ps(r->d.x), L->dy = _mm512_set1_ps(r->d.y), L->dz = _mm512_set1_ps(r->d.z);
+    L->nx = _mm512_set1_ps(r->on.x), L->ny = _mm512_set1_ps(r->on.y), L->nz = _mm512_set1_ps(r->on.z);
+    L->len = _mm512_set1_ps(r->len), L->h0 = _mm512_set1_ps(r->h0), L->dh = _mm512_set1_ps(r->dh);
+    L->zmin = _mm512_set1_ps(r->zmin), L->otol = _mm512_set1_ps(r->otol), L->cap = _mm512_set1_ps(r->cap);
+    L->xlen = _mm512_set1_ps(r->len * 1.0001f);
+    L->otol_on = r->otol > 0.0f;
+}
+
+/* The sample arrays (the tree's, or any laid out alike). */
+typedef struct soa16 {
+    const float *p[3], *n[3], *two;
+} soa16;
+
+static inline soa16 soa16_of(const cdl_skd *t)
+{
+    return (soa16){{t->p[0], t->p[1], t->p[2]}, {t->nrm[0], t->nrm[1], t->nrm[2]}, t->two};
+}
+
+/* wiz: whether zz is wanted (else left unwritten). */
+static inline uint32_t weigh16(const soa16 *t, uint32_t b, uint32_t m, const ray16 *L, int plane, int wiz, float *w,
+                               float *zz)
 {
     const __m512 zero = _mm512_setzero_ps();
-    const __m512 dx = _mm512_set1_ps(r->d.x), dy = _mm512_set1_ps(r->d.y), dz = _mm512_set1_ps(r->d.z);
-    const __m512 len = _mm512_set1_ps(r->len);
-    __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), _mm512_set1_ps(r->o.x));
-    __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), _mm512_set1_ps(r->o.y));
-    __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), _mm512_set1_ps(r->o.z));
+    const __m512 dx = L->dx, dy = L->dy, dz = L->dz;
+    __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), L->ox);
+    __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), L->oy);
+    __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), L->oz);
     __m512 z = _mm512_fmadd_ps(Dz, dz, _mm512_fmadd_ps(Dy, dy, _mm512_mul_ps(Dx, dx)));
     /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray would
      * lose r^2 to cancellation */
     __m512 ex = _mm512_fnmadd_ps(z, dx, Dx), ey = _mm512_fnmadd_ps(z, dy, Dy), ez = _mm512_fnmadd_ps(z, dz, Dz);
-    __m512 r2 = _mm512_fmadd_ps(ez, ez, _mm512_fmadd_ps(ey, ey, _mm512_mul_ps(ex, ex)));
-    __m512 h = _mm512_fmadd_ps(_mm512_set1_ps(r->dh), _mm512_min_ps(z, len), _mm512_set1_ps(r->h0));
-    __m512 h2 = _mm512_mul_ps(h, h), beyond = _mm512_sub_ps(z, len);
+    __m512 r2 = _mm512_fmadd_ps(ez, ez, _mm512_fmadd_ps(ey, ey, _mm512_mul_ps(ex, ex))); /* >= 0 */
+    __m512 h = _mm512_fmadd_ps(L->dh, _mm512_min_ps(z, L->len), L->h0);
+    __m512 h2 = _mm512_mul_ps(h, h);
     __mmask16 ok = (__mmask16)(m >= 16 ? 0xffffu : (1u << m) - 1u);
     /* inside the frustum (h only shrinks beyond the hit) and in front of
      * the origin: most lanes a large range tests fail here, before the
@@ -64,65 +92,84 @@ static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const c
     ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
     if (!ok)
         return 0;
-    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
-           nz = _mm512_loadu_ps(t->nrm[2] + b);
+    __m512 nx = _mm512_loadu_ps(t->n[0] + b), ny = _mm512_loadu_ps(t->n[1] + b), nz = _mm512_loadu_ps(t->n[2] + b);
+    __mmask16 two = _mm512_cmp_ps_mask(_mm512_loadu_ps(t->two + b), zero, _CMP_GT_OQ);
     __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
-    /* -|dn| for a two-sided sample */
-    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
-    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
-                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
+    /* c = -|dn| for a two-sided sample (its normal turned to face the
+     * ray), else dn */
+    const __m512 sign = _mm512_set1_ps(-0.0f);
+    __m512 c = _mm512_mask_or_ps(dn, two, dn, sign);
+    __m512 zn = _mm512_fmadd_ps(Dz, L->nz, _mm512_fmadd_ps(Dy, L->ny, _mm512_mul_ps(Dx, L->nx)));
     ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
     ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
-    /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
-    __m512 non = _mm512_fmadd_ps(nz, _mm512_set1_ps(r->on.z),
-                                 _mm512_fmadd_ps(ny, _mm512_set1_ps(r->on.y), _mm512_mul_ps(nx, _mm512_set1_ps(r->on.x))));
-    ok &= (__mmask16)(_mm512_cmp_ps_mask(zn, _mm512_set1_ps(r->zmin), _CMP_GE_OQ) |
-                      _mm512_cmp_ps_mask(non, _mm512_set1_ps(CDL_SKD_SHEET_COS), _CMP_GE_OQ));
+    /* not the other side of the origin's sheet (see cdl_splat_ray.zmin):
+     * only samples close to the origin's plane need their normal's */
+    __mmask16 low = _mm512_mask_cmp_ps_mask(ok, zn, L->zmin, _CMP_LT_OQ);
+    if (low) {
+        __m512 non = _mm512_fmadd_ps(nz, L->nz, _mm512_fmadd_ps(ny, L->ny, _mm512_mul_ps(nx, L->nx)));
+        ok &= (__mmask16)(~low | _mm512_cmp_ps_mask(non, _mm512_set1_ps(CDL_SKD_SHEET_COS), _CMP_GE_OQ));
+    }
     __m512 dpn = _mm512_fmadd_ps(Dz, nz, _mm512_fmadd_ps(Dy, ny, _mm512_mul_ps(Dx, nx)));
-    if (r->otol > 0.0f) /* the origin in front of a one-sided sample's plane (cdl_splat_ray.otol) */
-        ok &= (__mmask16)(_mm512_cmp_ps_mask(dpn, _mm512_set1_ps(r->otol), _CMP_LE_OQ) |
-                          _mm512_cmp_ps_mask(_mm512_loadu_ps(t->two + b), zero, _CMP_GT_OQ));
+    if (L->otol_on) /* the origin in front of a one-sided sample's plane (cdl_splat_ray.otol) */
+        ok &= (__mmask16)(_mm512_cmp_ps_mask(dpn, L->otol, _CMP_LE_OQ) | two);
+    __m512 beyond = _mm512_sub_ps(z, L->len);
     if (plane) {
         /* reached the sample's tangent plane ((D . n) / dn <= X, without
-         * the division), or ended within h of the sample (a neighbouring
-         * surface of a concave corner) */
-        __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, _mm512_set1_ps(r->len * 1.0001f));
-        __m512 Xdn = _mm512_mul_ps(X, dn);
-        __mmask16 neg = _mm512_cmp_ps_mask(dn, zero, _CMP_LT_OQ);
-        __mmask16 reached = (__mmask16)((neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_GE_OQ)) |
-                                        (~neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_LE_OQ)));
+         * the division: with the normal turned as c's, dn < 0 and the
+         * test flips), or ended within h of the sample (a neighbouring
+         * surface of a concave corner); r^2 < h^2 holds from above */
+        __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, L->xlen);
+        __m512 dpc = _mm512_mask_xor_ps(dpn, two, dpn, _mm512_and_ps(dn, sign));
+        __mmask16 reached = _mm512_cmp_ps_mask(dpc, _mm512_mul_ps(X, c), _CMP_GE_OQ);
         __mmask16 sphere = _mm512_cmp_ps_mask(_mm512_fmadd_ps(beyond, beyond, r2), h2, _CMP_LT_OQ);
-        __mmask16 within = _mm512_cmp_ps_mask(beyond, _mm512_mul_ps(_mm512_set1_ps(r->cap), h), _CMP_LE_OQ);
+        __mmask16 within = _mm512_cmp_ps_mask(beyond, _mm512_mul_ps(L->cap, h), _CMP_LE_OQ);
         __mmask16 before = _mm512_cmp_ps_mask(beyond, zero, _CMP_LE_OQ);
         ok &= (__mmask16)(before | (within & (reached | sphere)));
     } else {
         __m512 bp = _mm512_max_ps(beyond, zero);
         h2 = _mm512_fnmadd_ps(bp, bp, h2);
+        ok = _mm512_mask_cmp_ps_mask(ok, h2, zero, _CMP_GT_OQ);
+        ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
     }
-    ok = _mm512_mask_cmp_ps_mask(ok, h2, zero, _CMP_GT_OQ);
-    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
     if (!ok)
         return 0;
     __m512 ih2 = rcp_nr(h2);
     /* 1 - r^2 / h^2 >= 0 also where the reciprocal rounds */
-    __m512 k = _mm512_mul_ps(_mm512_max_ps(_mm512_fnmadd_ps(_mm512_max_ps(r2, zero), ih2, _mm512_set1_ps(1.0f)), zero),
-                             ih2);
-    __m512 wv = _mm512_mul_ps(_mm512_mul_ps(k, _mm512_set1_ps((float)(2.0 / CDL_PI))), _mm512_sub_ps(zero, c));
-    _mm512_storeu_ps(w, _mm512_maskz_mov_ps(ok, wv));
-    __mmask16 zpos = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GT_OQ);
-    _mm512_storeu_ps(zz, _mm512_maskz_mov_ps(zpos, rcp_nr(_mm512_mask_mov_ps(_mm512_set1_ps(1.0f), zpos, z))));
+    __m512 k = _mm512_mul_ps(_mm512_max_ps(_mm512_fnmadd_ps(r2, ih2, _mm512_set1_ps(1.0f)), zero), ih2);
+    /* k (2 / pi) (-c) */
+    _mm512_storeu_ps(w, _mm512_maskz_fnmadd_ps(ok, _mm512_mul_ps(k, _mm512_set1_ps((float)(2.0 / CDL_PI))), c, zero));
+    if (wiz) {
+        __mmask16 zpos = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GT_OQ);
+        _mm512_storeu_ps(zz, _mm512_maskz_mov_ps(zpos, rcp_nr(_mm512_mask_mov_ps(_mm512_set1_ps(1.0f), zpos, z))));
+    }
     return ok;
 }
 #else
-static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
+typedef struct ray16 {
+    cdl_splat_ray r;
+} ray16;
+
+static inline void ray16_of(ray16 *L, const cdl_splat_ray *r) { L->r = *r; }
+
+typedef struct soa16 {
+    const float *p[3], *n[3], *two;
+} soa16;
+
+static inline soa16 soa16_of(const cdl_skd *t)
+{
+    return (soa16){{t->p[0], t->p[1], t->p[2]}, {t->nrm[0], t->nrm[1], t->nrm[2]}, t->two};
+}
+
+static uint32_t weigh16(const soa16 *t, uint32_t b, uint32_t m, const ray16 *L, int plane, int wiz, float *w,
                         float *zz)
 {
+    const cdl_splat_ray *r = &L->r;
     const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
     const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
     const float zmin = r->zmin, otol = r->otol > 0.0f ? r->otol : INFINITY;
     const float norm = (float)(2.0 / CDL_PI);
     const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
-    const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
+    const float *nx = t->n[0] + b, *ny = t->n[1] + b, *nz = t->n[2] + b;
     const float *two = t->two + b;
 #pragma omp simd
     for (uint32_t i = 0; i < 16; i++) { /* all 16 lanes (the arrays have room): a fixed trip count */
@@ -157,7 +204,8 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
         float rr = r2 > 0.0f ? r2 : 0.0f;
         float wi = norm * (h2 - rr) * -c / (h2 * h2);
         w[i] = ok ? wi : 0.0f;
-        zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
+        if (wiz)
+            zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
     }
     uint32_t mask = 0;
     for (uint32_t i = 0; i < 16; i++)
@@ -168,7 +216,10 @@ static uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_spla
 
 uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz)
 {
-    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz) : weigh16(t, b, m, r, 0, w, iz);
+    ray16 L;
+    ray16_of(&L, r);
+    soa16 a = soa16_of(t);
+    return r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, iz) : weigh16(&a, b, m, &L, 0, 1, w, iz);
 }
 
 typedef struct trav {
@@ -176,8 +227,9 @@ typedef struct trav {
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
-    int cull, slabs, any;
-    cdl_skd_visit fn;
+    int cull, slabs, any, iz; /* iz: 1 / z wanted */
+    cdl_skd_visit fn;        /* 16 lanes a call, or */
+    cdl_skd_visit_range fnr; /* a range a call */
     void *ctx;
     cdl_skd_count *cnt;
 } trav;
@@ -206,9 +258,52 @@ static uint32_t frustum16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_sp
     return mask;
 }
 
+/* test_range for a range visitor: the leaf tests of a chunk into arrays,
+ * one call for all of it. mode: 0 CDL_SKD_ANY's frustum test, else the
+ * leaf test, 1 + plane + 2 wiz. */
+static inline void chunks(const trav *v, uint32_t lo, uint32_t hi, int mode)
+{
+    float w[CDL_SKD_CHUNK], zz[CDL_SKD_CHUNK];
+    uint16_t mask[CDL_SKD_CHUNK / 16];
+    ray16 L;
+    ray16_of(&L, v->r);
+    const soa16 a = soa16_of(v->t);
+    for (uint32_t c = lo; c < hi; c += CDL_SKD_CHUNK) {
+        uint32_t n = hi - c < CDL_SKD_CHUNK ? hi - c : CDL_SKD_CHUNK, any = 0;
+        for (uint32_t j = 0; j * 16 < n; j++) {
+            uint32_t b = c + 16 * j, m = n - 16 * j < 16 ? n - 16 * j : 16;
+            uint32_t in = mode ? weigh16(&a, b, m, &L, (mode - 1) & 1, (mode - 1) >> 1, w + 16 * j, zz + 16 * j)
+                               : frustum16(v->t, b, m, v->r, v->zmax, w + 16 * j, zz + 16 * j);
+            mask[j] = (uint16_t)in;
+            any |= in;
+        }
+        if (any)
+            v->fnr(v->ctx, c, n, mask, w, zz);
+    }
+}
+
+static void test_chunks(const trav *v, uint32_t lo, uint32_t hi)
+{
+    int plane = v->r->cap > 0.0f;
+    if (v->any)
+        chunks(v, lo, hi, 0);
+    else if (plane && v->iz)
+        chunks(v, lo, hi, 4);
+    else if (plane)
+        chunks(v, lo, hi, 2);
+    else if (v->iz)
+        chunks(v, lo, hi, 3);
+    else
+        chunks(v, lo, hi, 1);
+}
+
 static void test_range(const trav *v, uint32_t lo, uint32_t hi)
 {
     v->cnt->tested += hi - lo;
+    if (v->fnr) {
+        test_chunks(v, lo, hi);
+        return;
+    }
     if (v->any) {
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
@@ -219,10 +314,13 @@ static void test_range(const trav *v, uint32_t lo, uint32_t hi)
         }
         return;
     }
+    ray16 L;
+    ray16_of(&L, v->r);
+    const soa16 a = soa16_of(v->t);
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
-        uint32_t any = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz) : weigh16(v->t, b, m, v->r, 0, w, zz);
+        uint32_t any = v->r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, zz) : weigh16(&a, b, m, &L, 0, 1, w, zz);
         if (any)
             v->fn(v->ctx, b, m, any, w, zz);
     }
@@ -528,13 +626,14 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, cnt},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, 1, NULL, NULL, NULL,
+                    cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
 
-int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
-                        void *ctx, cdl_skd_count *cnt)
+static int splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                       cdl_skd_visit_range fnr, void *ctx, cdl_skd_count *cnt)
 {
     if (!t->n)
         return 0;
@@ -556,7 +655,9 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
               (flags & (CDL_SKD_CULL | CDL_SKD_ANY)) == CDL_SKD_CULL,
               (flags & CDL_SKD_SLABS) != 0,
               (flags & CDL_SKD_ANY) != 0,
+              !(flags & CDL_SKD_NOIZ),
               fn,
+              fnr,
               ctx,
               cnt};
     for (int a = 0; a < 3; a++)
@@ -590,6 +691,18 @@ int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
         traverse_wide(&v, e);
     return 0;
+}
+
+int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                        void *ctx, cdl_skd_count *cnt)
+{
+    return splat_visit(t, part, r, flags, fn, NULL, ctx, cnt);
+}
+
+int cdl_skd_splat_visit_range(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags,
+                              cdl_skd_visit_range fn, void *ctx, cdl_skd_count *cnt)
+{
+    return splat_visit(t, part, r, flags, NULL, fn, ctx, cnt);
 }
 
 static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *z)

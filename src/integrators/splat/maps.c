@@ -87,14 +87,13 @@ int splat_maps_init(splat_state *s, cdl_error *err)
 int splat_maps_alloc(splat_state *s, cdl_error *err)
 {
     size_t n = (size_t)s->nslots + 16;
-    if (!s->wsum) {
+    if (!s->nsum) {
         for (int c = 0; c < 3; c++)
             s->E[c] = malloc(sizeof(float) * n);
-        s->wsum = malloc(sizeof(float) * n);
         s->izsum = malloc(sizeof(float) * n);
         s->nsum = malloc(sizeof(float) * n);
         s->gloss = malloc(sizeof(uint32_t) * n);
-        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->nsum || !s->gloss)
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->izsum || !s->nsum || !s->gloss)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
     uint32_t ng = 0;
@@ -120,8 +119,8 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
 
 size_t splat_maps_bytes(const splat_state *s)
 {
-    size_t n = s->wsum ? (size_t)s->nslots + 16 : 0;
-    return n * (6 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+    size_t n = s->nsum ? (size_t)s->nslots + 16 : 0;
+    return n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
@@ -175,7 +174,6 @@ void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float i
     s->E[0][q] += w * flux.x;
     s->E[1][q] += w * flux.y;
     s->E[2][q] += w * flux.z;
-    s->wsum[q] += w;
     s->izsum[q] += iz;
     s->nsum[q] += 1.0f;
     if (s->gloss[q] != SPLAT_LAMBERT)
@@ -222,7 +220,9 @@ static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mas
 
 /* A batch of samples from the tree: every feasible one gets the ray's
  * irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
- * perhaps another thread's: masked); glossy ones their map entries too. */
+ * perhaps another thread's: masked); glossy ones their map entries too.
+ * izsum is the cache's (splat_maps_add): iz is read only by the masks,
+ * the occlusion test and the bandwidth picture. */
 static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
 {
     ray_ctx *c = ctx;
@@ -240,7 +240,7 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
             return;
     }
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
-    float *ws = s->wsum + first, *zs = s->izsum + first, *ns = s->nsum + first;
+    float *ns = s->nsum + first;
     const uint32_t *gl = s->gloss + first;
 #if defined(__AVX512F__)
     const __mmask16 k = (__mmask16)mask;
@@ -249,8 +249,6 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
     _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
     _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
-    _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
-    _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
     _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
     c->splats += (uint64_t)__builtin_popcount(mask);
@@ -263,8 +261,6 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
         er[i] += w[i] * fr;
         eg[i] += w[i] * fg;
         eb[i] += w[i] * fb;
-        ws[i] += w[i];
-        zs[i] += iz[i];
         ns[i] += 1.0f;
         glossy |= gl[i] != SPLAT_LAMBERT;
         c->splats++;
@@ -276,12 +272,20 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
         splat_bandwidth(c, first, m, mask, w, iz);
 }
 
+/* A leaf range from the tree: its 16-lane blocks with feasible samples,
+ * without a call each. */
+static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
+{
+    for (uint32_t j = 0; j * 16 < n; j++)
+        if (mask[j])
+            splat_batch(ctx, first + 16 * j, n - 16 * j < 16 ? n - 16 * j : 16, mask[j], w + 16 * j, iz + 16 * j);
+}
+
 void splat_maps_clear(splat_state *s)
 {
     size_t n = (size_t)s->neye + 16;
     for (int c = 0; c < 3; c++)
         memset(s->E[c], 0, sizeof(float) * n);
-    memset(s->wsum, 0, sizeof(float) * n);
     memset(s->izsum, 0, sizeof(float) * n);
     memset(s->nsum, 0, sizeof(float) * n);
     memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
@@ -293,7 +297,8 @@ int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
     uint64_t splats = 0, tested = 0, nodes = 0, masked = 0, occluded = 0, occl_rays = 0;
-    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
+    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0) |
+                      (s->mask || s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
     /* with visibility masks, a batch of rays at a time: masks first */
     uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
     if (s->mask && splat_mask_prepare(s))
@@ -314,7 +319,7 @@ int splat_maps_splat(splat_state *s)
                 c.t.r = r;
                 c.t.ready = 0;
                 c.ray = k;
-                cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
+                cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, splat_range, &c, &cnt);
             }
             splats += c.splats;
             masked += c.masked;

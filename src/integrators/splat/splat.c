@@ -567,7 +567,6 @@ static void splat_destroy(void *self)
     free(s->pix);
     for (int c = 0; c < 3; c++)
         free(s->E[c]);
-    free(s->wsum);
     free(s->izsum);
     free(s->nsum);
     free(s->gloss);
