@@ -93,7 +93,8 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
         s->izsum = malloc(sizeof(float) * n);
         s->nsum = malloc(sizeof(float) * n);
         s->gloss = malloc(sizeof(uint32_t) * n);
-        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->izsum || !s->nsum || !s->gloss)
+        s->gbits = malloc(sizeof(uint32_t) * (n / 32 + 3));
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->izsum || !s->nsum || !s->gloss || !s->gbits)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
     uint32_t ng = 0;
@@ -101,6 +102,9 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
         s->gloss[q] = s->eye[q].b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : ng++;
     for (uint32_t q = s->neye; q < s->neye + 16; q++)
         s->gloss[q] = SPLAT_LAMBERT;
+    memset(s->gbits, 0, sizeof(uint32_t) * ((s->neye + 16) / 32 + 3));
+    for (uint32_t q = 0; q < s->neye; q++)
+        s->gbits[q / 32] |= (uint32_t)(s->gloss[q] != SPLAT_LAMBERT) << (q % 32);
     s->nglossy = ng;
     if (ng > s->gcap || !s->gmap) {
         free(s->gmap);
@@ -120,7 +124,7 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
 size_t splat_maps_bytes(const splat_state *s)
 {
     size_t n = s->nsum ? (size_t)s->nslots + 16 : 0;
-    return n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+    return (n ? (n / 32 + 3) * sizeof(uint32_t) : 0) + n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
@@ -188,13 +192,13 @@ typedef struct ray_ctx {
     uint64_t splats, masked, occluded, occl_rays;
 } ray_ctx;
 
-/* The feasible glossy samples of a batch: the ray's light in their maps. */
-static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w)
+/* The feasible glossy samples of a batch (bit i: sample first + i): the
+ * ray's light in their maps. */
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const float *w)
 {
-    for (uint32_t i = 0; i < m; i++) {
-        uint32_t q = first + i, g = c->s->gloss[q];
-        if ((mask >> i & 1u) && g != SPLAT_LAMBERT)
-            add_glossy(c->s, &c->t, q, g, w[i]);
+    for (; glossy; glossy &= glossy - 1) {
+        uint32_t i = (uint32_t)__builtin_ctz(glossy), q = first + i;
+        add_glossy(c->s, &c->t, q, c->s->gloss[q], w[i]);
     }
 }
 
@@ -241,7 +245,11 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     }
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
     float *ns = s->nsum + first;
-    const uint32_t *gl = s->gloss + first;
+    /* the splat counts are the filter's only (the cache counts its own) */
+    const int count = s->opt.splat.filter > 0.0f;
+    uint64_t gb;
+    memcpy(&gb, s->gbits + first / 32, sizeof gb);
+    const uint32_t glossy = (uint32_t)(gb >> (first % 32)) & mask;
 #if defined(__AVX512F__)
     const __mmask16 k = (__mmask16)mask;
     const __m512 wv = _mm512_loadu_ps(w);
@@ -249,25 +257,23 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
     _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
     _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
-    _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
-    uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
+    if (count)
+        _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     c->splats += (uint64_t)__builtin_popcount(mask);
 #else
     const float fr = c->t.r->flux.x, fg = c->t.r->flux.y, fb = c->t.r->flux.z;
-    uint32_t glossy = 0;
     for (uint32_t i = 0; i < m; i++) {
         if (!(mask >> i & 1u))
             continue;
         er[i] += w[i] * fr;
         eg[i] += w[i] * fg;
         eb[i] += w[i] * fb;
-        ns[i] += 1.0f;
-        glossy |= gl[i] != SPLAT_LAMBERT;
+        ns[i] += count ? 1.0f : 0.0f;
         c->splats++;
     }
 #endif
     if (glossy)
-        splat_glossy(c, first, m, mask, w);
+        splat_glossy(c, first, glossy, w);
     if (s->want_bw)
         splat_bandwidth(c, first, m, mask, w, iz);
 }

@@ -568,6 +568,7 @@ static void splat_destroy(void *self)
     for (int c = 0; c < 3; c++)
         free(s->E[c]);
     free(s->izsum);
+    free(s->gbits);
     free(s->nsum);
     free(s->gloss);
     free(s->gmap);
