@@ -196,6 +196,21 @@ typedef struct ray_ctx {
  * ray's light in their maps. */
 static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const float *w)
 {
+    splat_state *s = c->s;
+    if (s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) { /* add_glossy's, the stratum's image found once */
+        if (!c->t.ready)
+            splat_terms_of(&c->t, s, c->t.r);
+        float *mp = gmap_at(s, 0, c->t.stratum);
+        const cdl_vec3 flux = c->t.r->flux;
+        for (; glossy; glossy &= glossy - 1) {
+            uint32_t i = (uint32_t)__builtin_ctz(glossy);
+            float *m = mp + 3 * (size_t)s->gloss[first + i];
+            m[0] += w[i] * flux.x;
+            m[1] += w[i] * flux.y;
+            m[2] += w[i] * flux.z;
+        }
+        return;
+    }
     for (; glossy; glossy &= glossy - 1) {
         uint32_t i = (uint32_t)__builtin_ctz(glossy), q = first + i;
         add_glossy(c->s, &c->t, q, c->s->gloss[q], w[i]);
