@@ -211,6 +211,18 @@ static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const floa
         }
         return;
     }
+    if (s->opt.splat.mode == CDL_SPLAT_SH) { /* add_glossy's, inline */
+        if (!c->t.ready)
+            splat_terms_of(&c->t, s, c->t.r);
+        const float *sh = c->t.sh;
+        for (; glossy; glossy &= glossy - 1) {
+            uint32_t i = (uint32_t)__builtin_ctz(glossy);
+            float *m = gmap_at(s, s->gloss[first + i], 0), wi = w[i];
+            for (int k = 0; k < CDL_SH_N * 3; k++)
+                m[k] += wi * sh[k];
+        }
+        return;
+    }
     for (; glossy; glossy &= glossy - 1) {
         uint32_t i = (uint32_t)__builtin_ctz(glossy), q = first + i;
         add_glossy(c->s, &c->t, q, c->s->gloss[q], w[i]);
