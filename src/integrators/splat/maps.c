@@ -281,9 +281,15 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
     const __mmask16 k = (__mmask16)mask;
     const __m512 wv = _mm512_loadu_ps(w);
     const cdl_vec3 flux = c->t.r->flux;
-    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
-    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
-    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    if (m == 16) { /* all 16 lanes this part's: plain loads and stores, unfed lanes rewritten unchanged */
+        _mm512_storeu_ps(er, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_loadu_ps(er), k));
+        _mm512_storeu_ps(eg, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_loadu_ps(eg), k));
+        _mm512_storeu_ps(eb, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_loadu_ps(eb), k));
+    } else {
+        _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
+        _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
+        _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    }
     if (count)
         _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     c->splats += (uint64_t)__builtin_popcount(mask);
