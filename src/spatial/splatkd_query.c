@@ -119,7 +119,7 @@ static inline uint32_t weigh16(const soa16 *t, uint32_t b, uint32_t m, const ray
          * test flips), or ended within h of the sample (a neighbouring
          * surface of a concave corner); r^2 < h^2 holds from above */
         __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, L->xlen);
-        __m512 dpc = _mm512_mask_xor_ps(dpn, two, dpn, _mm512_and_ps(dn, sign));
+        __m512 dpc = _mm512_mask_xor_ps(dpn, two, dpn, _mm512_andnot_ps(dn, sign));
         __mmask16 reached = _mm512_cmp_ps_mask(dpc, _mm512_mul_ps(X, c), _CMP_GE_OQ);
         __mmask16 sphere = _mm512_cmp_ps_mask(_mm512_fmadd_ps(beyond, beyond, r2), h2, _CMP_LT_OQ);
         __mmask16 within = _mm512_cmp_ps_mask(beyond, _mm512_mul_ps(L->cap, h), _CMP_LE_OQ);
