@@ -56,8 +56,12 @@ static int cmp_hit(const void *a, const void *b)
 static void append_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
 {
     cdl_splat_hits *out = ctx;
+    if (n > CDL_SKD_CHUNK || (n % 16 && mask[n / 16] >> (n % 16))) /* lanes past the range */
+        out->fail = 1;
     for (uint32_t i = 0; i < n; i++)
-        if ((mask[i / 16] >> (i % 16) & 1u) && w[i] > 0.0f) {
+        if (mask[i / 16] >> (i % 16) & 1u) {
+            if (!(w[i] > 0.0f)) /* a feasible lane weighing 0 */
+                out->fail = 1;
             if (out->n == out->cap) {
                 out->cap = out->cap ? 2 * out->cap : 1024;
                 out->h = realloc(out->h, sizeof *out->h * out->cap);
@@ -114,8 +118,15 @@ static void traversal(void)
         tested_cull += b.tested - t0;
         nodes_cull += b.nodes - n0;
         t0 = c.tested;
-        for (uint32_t q = 0; q < t.nparts; q++)
-            cdl_skd_splat(&t, q, &ray, k % 4 == 0 ? CDL_SKD_CULL : 0, &c);
+        for (uint32_t q = 0; q < t.nparts; q++) {
+            if (k % 2) { /* part by part, a range a visit */
+                cdl_skd_count pc = {0, 0};
+                cdl_skd_splat_visit_range(&t, q, &ray, k % 4 == 1 ? CDL_SKD_CULL : 0, append_range, &c, &pc);
+                c.tested += pc.tested;
+            } else {
+                cdl_skd_splat(&t, q, &ray, k % 4 == 0 ? CDL_SKD_CULL : 0, &c);
+            }
+        }
         tested_plain += c.tested - t0;
         t0 = e.tested, n0 = e.nodes;
         cdl_skd_splat(&t, UINT32_MAX, &ray, CDL_SKD_CULL | CDL_SKD_SLABS, &e);
@@ -161,7 +172,8 @@ static void traversal(void)
           "frustum traversal (bounding spheres, whole tree and part by part, 16 lanes or a range a visit; Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
           "differ by more than 1e-4 of the ray's largest, %u distances z by more than 1e-5 z + 1e-6)",
           total, wrong, wdiff, izdiff);
-    CHECK(ranges_tested == tested_cull, "the range visit tests the samples the 16-lane visit tests (%llu, %llu)",
+    CHECK(ranges_tested == tested_cull && !f.fail && !c.fail,
+          "the range visit tests the samples the 16-lane visit tests (%llu, %llu), its masks within the chunks",
           (unsigned long long)ranges_tested, (unsigned long long)tested_cull);
     CHECK(tested_cull < 20ull * total, "the traversal tests few samples per feasible one (%.2f)",
           (double)tested_cull / total);
