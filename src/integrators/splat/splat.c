@@ -280,7 +280,9 @@ static int eye_pass(splat_state *s, uint32_t pass, int y0, int y1, uint64_t *ray
     /* the valid slots, in slot order, become the eye samples */
     uint32_t n = 0, nk = (uint32_t)(y1 - y0) * (uint32_t)s->opt.camera.width * s->opt.splat.eye_samples * s->G;
     for (uint32_t k = 0; k < nk; k++)
-        if (s->svalid[k]) {
+        if (s->svalid[k] && n == k) { /* in place until the first invalid one */
+            n++;
+        } else if (s->svalid[k]) {
             s->slot[n] = s->slot[k];
             s->sp[n] = s->sp[k];
             s->sn[n] = s->sn[k];
@@ -299,6 +301,8 @@ static int build(splat_state *s, cdl_error *err)
         return err->code;
     if (!s->eye && !(s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1))))
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the eye samples");
+    /* 1M samples of ~340 bytes: a gather worth both threads */
+#pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++)
         s->eye[q] = s->slot[s->tree.order[q]];
     return splat_maps_alloc(s, err);
