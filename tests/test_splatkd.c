@@ -169,7 +169,8 @@ static void traversal(void)
         }
     }
     CHECK(wrong == 0 && wdiff == 0 && izdiff == 0 && total > 20000,
-          "frustum traversal (bounding spheres, whole tree and part by part, 16 lanes or a range a visit; Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
+          "frustum traversal (bounding spheres, whole tree and part by part, 16 lanes or a range a visit; "
+          "Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
           "differ by more than 1e-4 of the ray's largest, %u distances z by more than 1e-5 z + 1e-6)",
           total, wrong, wdiff, izdiff);
     CHECK(ranges_tested == tested_cull && !f.fail && !c.fail,

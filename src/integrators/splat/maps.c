@@ -124,7 +124,8 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
 size_t splat_maps_bytes(const splat_state *s)
 {
     size_t n = s->nsum ? (size_t)s->nslots + 16 : 0;
-    return (n ? (n / 32 + 3) * sizeof(uint32_t) : 0) + n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+    return (n ? (n / 32 + 3) * sizeof(uint32_t) : 0) +
+           n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
