@@ -53,6 +53,25 @@ static int cmp_hit(const void *a, const void *b)
     return (x->s > y->s) - (x->s < y->s);
 }
 
+/* A range visitor appending its hits (iz checked against the 16-lane
+ * visit's in the comparison with brute force). */
+static void append_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
+{
+    cdl_splat_hits *out = ctx;
+    if (n > CDL_SKD_CHUNK || (n % 16 && mask[n / 16] >> (n % 16))) /* lanes past the range */
+        out->fail = 1;
+    for (uint32_t i = 0; i < n; i++)
+        if (mask[i / 16] >> (i % 16) & 1u) {
+            if (!(w[i] > 0.0f)) /* a feasible lane weighing 0 */
+                out->fail = 1;
+            if (out->n == out->cap) {
+                out->cap = out->cap ? 2 * out->cap : 1024;
+                out->h = realloc(out->h, sizeof *out->h * out->cap);
+            }
+            out->h[out->n++] = (cdl_splat_hit){first + i, w[i], iz[i]};
+        }
+}
+
 static void traversal(void)
 {
     cdl_rng r;
@@ -80,9 +99,10 @@ static void traversal(void)
     for (uint32_t k = 0; k < t.nparts; k++)
         parts_cover += t.parts[k].hi - t.parts[k].lo;
     CHECK(parts_cover == n && t.nparts > 8, "%u parts cover the samples once", t.nparts);
-    cdl_splat_hits a = {0}, b = {0}, c = {0}, e = {0};
+    cdl_splat_hits a = {0}, b = {0}, c = {0}, e = {0}, f = {0};
     uint32_t wrong = 0, total = 0, wdiff = 0;
-    uint64_t tested_cull = 0, tested_plain = 0, tested_slabs = 0, nodes_cull = 0, nodes_slabs = 0;
+    uint32_t izdiff = 0;
+    uint64_t ranges_tested = 0, tested_cull = 0, tested_plain = 0, tested_slabs = 0, nodes_cull = 0, nodes_slabs = 0;
     for (int k = 0; k < 600; k++) {
         cdl_splat_ray ray;
         ray.o = cdl_v3(1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f, 1.2f * cdl_rng_float(&r) - 0.1f);
@@ -93,22 +113,32 @@ static void traversal(void)
         ray.dh = k % 2 ? 0.0f : 0.2f * cdl_rng_float(&r);
         ray.cap = k % 3 == 1 ? 0.0f : 4.0f;
         ray.zmin = k % 3 ? 0.0f : 1e-3f;
-        a.n = b.n = c.n = e.n = 0;
+        a.n = b.n = c.n = e.n = f.n = 0;
         cdl_skd_splat_brute(&t, UINT32_MAX, &ray, &a);
         uint64_t t0 = b.tested, n0 = b.nodes;
         cdl_skd_splat(&t, UINT32_MAX, &ray, CDL_SKD_CULL, &b);
         tested_cull += b.tested - t0;
         nodes_cull += b.nodes - n0;
         t0 = c.tested;
-        for (uint32_t q = 0; q < t.nparts; q++)
-            cdl_skd_splat(&t, q, &ray, k % 4 == 0 ? CDL_SKD_CULL : 0, &c);
+        for (uint32_t q = 0; q < t.nparts; q++) {
+            if (k % 2) { /* part by part, a range a visit */
+                cdl_skd_count pc = {0, 0, 0};
+                cdl_skd_splat_visit_range(&t, q, &ray, k % 4 == 1 ? CDL_SKD_CULL : 0, append_range, &c, &pc);
+                c.tested += pc.tested;
+            } else {
+                cdl_skd_splat(&t, q, &ray, k % 4 == 0 ? CDL_SKD_CULL : 0, &c);
+            }
+        }
         tested_plain += c.tested - t0;
         t0 = e.tested, n0 = e.nodes;
         cdl_skd_splat(&t, UINT32_MAX, &ray, CDL_SKD_CULL | CDL_SKD_SLABS, &e);
         tested_slabs += e.tested - t0;
         nodes_slabs += e.nodes - n0;
-        cdl_splat_hits *all[4] = {&a, &b, &c, &e};
-        for (int o = 0; o < 4; o++)
+        cdl_skd_count cnt = {0, 0, 0};
+        cdl_skd_splat_visit_range(&t, UINT32_MAX, &ray, CDL_SKD_CULL, append_range, &f, &cnt);
+        ranges_tested += cnt.tested;
+        cdl_splat_hits *all[5] = {&a, &b, &c, &e, &f};
+        for (int o = 0; o < 5; o++)
             if (all[o]->n)
                 qsort(all[o]->h, all[o]->n, sizeof *all[o]->h, cmp_hit);
         total += a.n;
@@ -118,8 +148,8 @@ static void traversal(void)
         float wmax = 0.0f;
         for (uint32_t i = 0; i < a.n; i++)
             wmax = fmaxf(wmax, a.h[i].w);
-        const cdl_splat_hits *other[3] = {&b, &c, &e};
-        for (int o = 0; o < 3; o++) {
+        const cdl_splat_hits *other[4] = {&b, &c, &e, &f};
+        for (int o = 0; o < 4; o++) {
             const cdl_splat_hits *x = other[o];
             uint32_t i = 0, j = 0;
             while (i < a.n || j < x->n) {
@@ -131,15 +161,23 @@ static void traversal(void)
                     j++;
                 } else {
                     wdiff += fabsf(a.h[i].w - x->h[j].w) > 1e-4f * wmax;
+                    /* z itself to rounding (1 / z amplifies z's error near 0) */
+                    float za = a.h[i].iz > 0.0f ? 1.0f / a.h[i].iz : 0.0f;
+                    float zb = x->h[j].iz > 0.0f ? 1.0f / x->h[j].iz : 0.0f;
+                    izdiff += fabsf(za - zb) > 1e-5f * za + 1e-6f;
                     i++, j++;
                 }
             }
         }
     }
-    CHECK(wrong == 0 && wdiff == 0 && total > 20000,
-          "frustum traversal (bounding spheres, whole tree and part by part; Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
-          "differ by more than 1e-4 of the ray's largest)",
-          total, wrong, wdiff);
+    CHECK(wrong == 0 && wdiff == 0 && izdiff == 0 && total > 20000,
+          "frustum traversal (bounding spheres, whole tree and part by part, 16 lanes or a range a visit; "
+          "Algorithm 1's slabs) = brute force over 600 rays (%u feasible samples; %u found by one only, %u weights "
+          "differ by more than 1e-4 of the ray's largest, %u distances z by more than 1e-5 z + 1e-6)",
+          total, wrong, wdiff, izdiff);
+    CHECK(ranges_tested == tested_cull && !f.fail && !c.fail,
+          "the range visit tests the samples the 16-lane visit tests (%llu, %llu), its masks within the chunks",
+          (unsigned long long)ranges_tested, (unsigned long long)tested_cull);
     CHECK(tested_cull < 20ull * total, "the traversal tests few samples per feasible one (%.2f)",
           (double)tested_cull / total);
     /* the wide tree tests whole small subtrees (branch-free 16-lane tests)
@@ -153,6 +191,7 @@ static void traversal(void)
     free(b.h);
     free(c.h);
     free(e.h);
+    free(f.h);
     cdl_skd_free(&t);
     free(p);
     free(nr);

@@ -203,7 +203,8 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 /* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
  * report's traversal) instead of the default bounding-sphere test per
  * node (the same samples, fewer tested). */
-enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2 };
+enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_NOIZ = 8 };
+/* CDL_SKD_NOIZ: a range visit's iz is not wanted (left unwritten). */
 
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)
@@ -234,6 +235,16 @@ typedef void (*cdl_skd_visit_both)(void *ctx, uint32_t first, uint32_t m, uint32
                                    uint32_t feasible, const float *w, const float *iz);
 int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,
                              cdl_skd_count *cnt);
+/* The same a range at a time: samples [first, first + n), n <=
+ * CDL_SKD_CHUNK, in 16-lane blocks; mask[j] holds the feasible lanes of
+ * block j (samples first + 16 j + i), and w, iz hold 16 entries a block,
+ * written only for blocks with a nonzero mask. One call per leaf range
+ * instead of one per 16 lanes: the leaf test runs without calls. */
+#define CDL_SKD_CHUNK 128
+typedef void (*cdl_skd_visit_range)(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w,
+                                    const float *iz);
+int cdl_skd_splat_visit_range(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags,
+                              cdl_skd_visit_range fn, void *ctx, cdl_skd_count *cnt);
 /* The leaf test alone (Algorithm 2) for samples [b, b + m), m <= 16, of
  * any arrays laid out as the tree's p, nrm and two (16 floats of padding
  * past the last): w and iz as a visit gets them; returns the mask of

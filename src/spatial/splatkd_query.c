@@ -1,12 +1,14 @@
 /* Queries of the eye-sample kd-tree (Herzog et al. 2007, §5.2): the
  * photon ray's frustum traversal (bounding spheres, or Algorithm 1's 1D
- * slabs), Algorithm 2's leaf test 16 samples at a time, the visitor and
- * hit-list interfaces, brute force for tests, and the subtree regions and
- * stop lists the radiance cache uses. The build is in splatkd.c. */
+ * slabs), Algorithm 2's leaf test (splatkd_leaf.h) over its ranges, the
+ * 16-lane and range visitor and hit-list interfaces, brute force for
+ * tests, and the subtree regions and stop lists the radiance cache uses.
+ * The build is in splatkd.c. */
 #include "spatial/splatkd.h"
 
 #include "core/grow.h"
 #include "core/octahedral.h"
+#include "spatial/splatkd_leaf.h"
 #include "spatial/splatkd_node.h"
 
 #include <math.h>
@@ -26,178 +28,12 @@ static int add_hit(cdl_splat_hits *out, uint32_t s, float w, float iz)
     return 0;
 }
 
-/* The both visit's frustum test, on the way (see cdl_skd_visit_both):
- * lanes inside the frustum up to zmax and their z; culled: the leaf test
- * is not wanted. */
-typedef struct any16 {
-    float zmax;
-    int culled;
-    uint32_t mask;
-    float *z;
-} any16;
-
-/* Algorithm 2's feasibility and weight for up to 16 samples from b:
- * w[i] kernel times cosine (0 where infeasible), zz[i] 1 / z; returns
- * the mask of feasible lanes; with a, the frustum test too. `plane` is a constant in each caller;
- * cdl_splat_weight is the same test one sample at a time. With AVX-512
- * the 16 lanes are one register and the reciprocals rcp14 with a Newton
- * step (relative error ~1e-7); otherwise a branch-free loop that the
- * compiler vectorizes. */
-#if defined(__AVX512F__)
-static inline __m512 rcp_nr(__m512 x)
-{
-    __m512 r = _mm512_rcp14_ps(x);
-    return _mm512_mul_ps(r, _mm512_fnmadd_ps(x, r, _mm512_set1_ps(2.0f)));
-}
-
-static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane,
-                               float *w, float *zz, any16 *a)
-{
-    const __m512 zero = _mm512_setzero_ps();
-    const __m512 dx = _mm512_set1_ps(r->d.x), dy = _mm512_set1_ps(r->d.y), dz = _mm512_set1_ps(r->d.z);
-    const __m512 len = _mm512_set1_ps(r->len);
-    __m512 Dx = _mm512_sub_ps(_mm512_loadu_ps(t->p[0] + b), _mm512_set1_ps(r->o.x));
-    __m512 Dy = _mm512_sub_ps(_mm512_loadu_ps(t->p[1] + b), _mm512_set1_ps(r->o.y));
-    __m512 Dz = _mm512_sub_ps(_mm512_loadu_ps(t->p[2] + b), _mm512_set1_ps(r->o.z));
-    __m512 z = _mm512_fmadd_ps(Dz, dz, _mm512_fmadd_ps(Dy, dy, _mm512_mul_ps(Dx, dx)));
-    /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray would
-     * lose r^2 to cancellation */
-    __m512 ex = _mm512_fnmadd_ps(z, dx, Dx), ey = _mm512_fnmadd_ps(z, dy, Dy), ez = _mm512_fnmadd_ps(z, dz, Dz);
-    __m512 r2 = _mm512_fmadd_ps(ez, ez, _mm512_fmadd_ps(ey, ey, _mm512_mul_ps(ex, ex)));
-    __m512 h = _mm512_fmadd_ps(_mm512_set1_ps(r->dh), _mm512_min_ps(z, len), _mm512_set1_ps(r->h0));
-    __m512 h2 = _mm512_mul_ps(h, h), beyond = _mm512_sub_ps(z, len);
-    __mmask16 ok = (__mmask16)(m >= 16 ? 0xffffu : (1u << m) - 1u);
-    /* inside the frustum (h only shrinks beyond the hit) and in front of
-     * the origin: most lanes a large range tests fail here, before the
-     * normals are loaded */
-    ok = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GE_OQ);
-    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
-    if (a) {
-        a->mask = _mm512_mask_cmp_ps_mask(ok, z, _mm512_set1_ps(a->zmax), _CMP_LE_OQ);
-        _mm512_storeu_ps(a->z, z);
-        if (a->culled)
-            return 0;
-    }
-    if (!ok)
-        return 0;
-    __m512 nx = _mm512_loadu_ps(t->nrm[0] + b), ny = _mm512_loadu_ps(t->nrm[1] + b),
-           nz = _mm512_loadu_ps(t->nrm[2] + b);
-    __m512 dn = _mm512_fmadd_ps(dz, nz, _mm512_fmadd_ps(dy, ny, _mm512_mul_ps(dx, nx)));
-    /* -|dn| for a two-sided sample */
-    __m512 c = _mm512_fnmadd_ps(_mm512_loadu_ps(t->two + b), _mm512_add_ps(dn, _mm512_abs_ps(dn)), dn);
-    __m512 zn = _mm512_fmadd_ps(Dz, _mm512_set1_ps(r->on.z),
-                                _mm512_fmadd_ps(Dy, _mm512_set1_ps(r->on.y), _mm512_mul_ps(Dx, _mm512_set1_ps(r->on.x))));
-    ok = _mm512_mask_cmp_ps_mask(ok, c, zero, _CMP_LT_OQ);
-    ok = _mm512_mask_cmp_ps_mask(ok, zn, zero, _CMP_GE_OQ);
-    /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
-    __m512 non = _mm512_fmadd_ps(nz, _mm512_set1_ps(r->on.z),
-                                 _mm512_fmadd_ps(ny, _mm512_set1_ps(r->on.y), _mm512_mul_ps(nx, _mm512_set1_ps(r->on.x))));
-    ok &= (__mmask16)(_mm512_cmp_ps_mask(zn, _mm512_set1_ps(r->zmin), _CMP_GE_OQ) |
-                      _mm512_cmp_ps_mask(non, _mm512_set1_ps(CDL_SKD_SHEET_COS), _CMP_GE_OQ));
-    __m512 dpn = _mm512_fmadd_ps(Dz, nz, _mm512_fmadd_ps(Dy, ny, _mm512_mul_ps(Dx, nx)));
-    if (r->otol > 0.0f) /* the origin in front of a one-sided sample's plane (cdl_splat_ray.otol) */
-        ok &= (__mmask16)(_mm512_cmp_ps_mask(dpn, _mm512_set1_ps(r->otol), _CMP_LE_OQ) |
-                          _mm512_cmp_ps_mask(_mm512_loadu_ps(t->two + b), zero, _CMP_GT_OQ));
-    if (plane) {
-        /* reached the sample's tangent plane ((D . n) / dn <= X, without
-         * the division), or ended within h of the sample (a neighbouring
-         * surface of a concave corner) */
-        __m512 X = _mm512_fmadd_ps(_mm512_set1_ps(1e-3f), h, _mm512_set1_ps(r->len * 1.0001f));
-        __m512 Xdn = _mm512_mul_ps(X, dn);
-        __mmask16 neg = _mm512_cmp_ps_mask(dn, zero, _CMP_LT_OQ);
-        __mmask16 reached = (__mmask16)((neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_GE_OQ)) |
-                                        (~neg & _mm512_cmp_ps_mask(dpn, Xdn, _CMP_LE_OQ)));
-        __mmask16 sphere = _mm512_cmp_ps_mask(_mm512_fmadd_ps(beyond, beyond, r2), h2, _CMP_LT_OQ);
-        __mmask16 within = _mm512_cmp_ps_mask(beyond, _mm512_mul_ps(_mm512_set1_ps(r->cap), h), _CMP_LE_OQ);
-        __mmask16 before = _mm512_cmp_ps_mask(beyond, zero, _CMP_LE_OQ);
-        ok &= (__mmask16)(before | (within & (reached | sphere)));
-    } else {
-        __m512 bp = _mm512_max_ps(beyond, zero);
-        h2 = _mm512_fnmadd_ps(bp, bp, h2);
-    }
-    ok = _mm512_mask_cmp_ps_mask(ok, h2, zero, _CMP_GT_OQ);
-    ok = _mm512_mask_cmp_ps_mask(ok, r2, h2, _CMP_LT_OQ);
-    if (!ok)
-        return 0;
-    __m512 ih2 = rcp_nr(h2);
-    /* 1 - r^2 / h^2 >= 0 also where the reciprocal rounds */
-    __m512 k = _mm512_mul_ps(_mm512_max_ps(_mm512_fnmadd_ps(_mm512_max_ps(r2, zero), ih2, _mm512_set1_ps(1.0f)), zero),
-                             ih2);
-    __m512 wv = _mm512_mul_ps(_mm512_mul_ps(k, _mm512_set1_ps((float)(2.0 / CDL_PI))), _mm512_sub_ps(zero, c));
-    _mm512_storeu_ps(w, _mm512_maskz_mov_ps(ok, wv));
-    __mmask16 zpos = _mm512_mask_cmp_ps_mask(ok, z, zero, _CMP_GT_OQ);
-    _mm512_storeu_ps(zz, _mm512_maskz_mov_ps(zpos, rcp_nr(_mm512_mask_mov_ps(_mm512_set1_ps(1.0f), zpos, z))));
-    return ok;
-}
-#else
-static inline uint32_t weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, int plane, float *w,
-                               float *zz, any16 *a)
-{
-    const float ox = r->o.x, oy = r->o.y, oz = r->o.z, dx = r->d.x, dy = r->d.y, dz = r->d.z;
-    const float nx0 = r->on.x, ny0 = r->on.y, nz0 = r->on.z, len = r->len, h0 = r->h0, dh = r->dh, cap = r->cap;
-    const float zmin = r->zmin, otol = r->otol > 0.0f ? r->otol : INFINITY;
-    const float norm = (float)(2.0 / CDL_PI);
-    const float *px = t->p[0] + b, *py = t->p[1] + b, *pz = t->p[2] + b;
-    const float *nx = t->nrm[0] + b, *ny = t->nrm[1] + b, *nz = t->nrm[2] + b;
-    const float *two = t->two + b;
-    const float zmax = a ? a->zmax : 0.0f;
-    float zo[16];
-    int in[16];
-#pragma omp simd
-    for (uint32_t i = 0; i < 16; i++) { /* all 16 lanes (the arrays have room): a fixed trip count */
-        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz;
-        float dn = dx * nx[i] + dy * ny[i] + dz * nz[i];
-        float c = dn - two[i] * (dn + fabsf(dn)); /* -|dn| for a two-sided sample */
-        float z = Dx * dx + Dy * dy + Dz * dz;
-        float zn = Dx * nx0 + Dy * ny0 + Dz * nz0;
-        /* |D - z d|^2, not |D|^2 - z^2: thin kernels far along the ray
-         * would lose r^2 to cancellation */
-        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
-        float r2 = ex * ex + ey * ey + ez * ez;
-        float h = h0 + dh * (z < len ? z : len);
-        float h2 = h * h, beyond = z - len;
-        in[i] = (z >= 0.0f) & (z <= zmax) & (r2 < h2) & (i < m);
-        zo[i] = z;
-        float non = nx[i] * nx0 + ny[i] * ny0 + nz[i] * nz0;
-        /* not the other side of the origin's sheet (see cdl_splat_ray.zmin) */
-        int ok = (c < 0.0f) & (z >= 0.0f) & (zn >= 0.0f) & ((zn >= zmin) | (non >= CDL_SKD_SHEET_COS));
-        float dpn = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
-        ok &= (dpn <= otol) | (two[i] > 0.0f); /* cdl_splat_ray.otol */
-        if (plane) {
-            /* the distance tp = (D . n) / dn to the sample's tangent plane
-             * against X, without the division: dn < 0 flips the test */
-            float X = len * 1.0001f + 1e-3f * h;
-            int reached = ((dn < 0.0f) & (dpn >= X * dn)) | ((dn >= 0.0f) & (dpn <= X * dn));
-            /* reached the sample's tangent plane, or ended within h of the
-             * sample (a neighbouring surface of a concave corner) */
-            ok &= (beyond <= 0.0f) | ((beyond <= cap * h) & (reached | (r2 + beyond * beyond < h2)));
-        } else {
-            h2 -= beyond > 0.0f ? beyond * beyond : 0.0f;
-        }
-        ok &= (h2 > 0.0f) & (r2 < h2) & (i < m);
-        float rr = r2 > 0.0f ? r2 : 0.0f;
-        float wi = norm * (h2 - rr) * -c / (h2 * h2);
-        w[i] = ok ? wi : 0.0f;
-        zz[i] = z > 0.0f ? 1.0f / z : 0.0f;
-    }
-    if (a) {
-        a->mask = 0;
-        for (uint32_t i = 0; i < 16; i++)
-            a->mask |= (uint32_t)in[i] << i;
-        memcpy(a->z, zo, sizeof zo);
-        if (a->culled)
-            return 0;
-    }
-    uint32_t mask = 0;
-    for (uint32_t i = 0; i < 16; i++)
-        mask |= (uint32_t)(w[i] > 0.0f) << i;
-    return mask;
-}
-#endif
-
 uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz)
 {
-    return r->cap > 0.0f ? weigh16(t, b, m, r, 1, w, iz, NULL) : weigh16(t, b, m, r, 0, w, iz, NULL);
+    ray16 L;
+    ray16_of(&L, r);
+    soa16 a = soa16_of(t);
+    return r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, iz, NULL) : weigh16(&a, b, m, &L, 0, 1, w, iz, NULL);
 }
 
 typedef struct trav {
@@ -205,37 +41,78 @@ typedef struct trav {
     const cdl_splat_ray *r;
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
-    int cull, slabs, both;
-    cdl_skd_visit fn;
-    cdl_skd_visit_both fnb;
+    int cull, slabs, both, iz; /* iz: 1 / z wanted */
+    cdl_skd_visit fn;          /* 16 lanes a call, or */
+    cdl_skd_visit_range fnr;   /* a range a call, or */
+    cdl_skd_visit_both fnb;    /* 16 lanes a call, frustum and feasible */
     void *ctx;
     cdl_skd_count *cnt;
 } trav;
+
+/* test_range for a range visitor: the leaf tests of a chunk into arrays,
+ * one call for all of it. mode: 1 + plane + 2 wiz. */
+static inline void chunks(const trav *v, uint32_t lo, uint32_t hi, int mode)
+{
+    float w[CDL_SKD_CHUNK], zz[CDL_SKD_CHUNK];
+    uint16_t mask[CDL_SKD_CHUNK / 16];
+    ray16 L;
+    ray16_of(&L, v->r);
+    const soa16 a = soa16_of(v->t);
+    for (uint32_t c = lo; c < hi; c += CDL_SKD_CHUNK) {
+        uint32_t n = hi - c < CDL_SKD_CHUNK ? hi - c : CDL_SKD_CHUNK, any = 0;
+        for (uint32_t j = 0; j * 16 < n; j++) {
+            uint32_t b = c + 16 * j, m = n - 16 * j < 16 ? n - 16 * j : 16;
+            uint32_t in = weigh16(&a, b, m, &L, (mode - 1) & 1, (mode - 1) >> 1, w + 16 * j, zz + 16 * j, NULL);
+            mask[j] = (uint16_t)in;
+            any |= in;
+        }
+        if (any)
+            v->fnr(v->ctx, c, n, mask, w, zz);
+    }
+}
+
+static void test_chunks(const trav *v, uint32_t lo, uint32_t hi)
+{
+    int plane = v->r->cap > 0.0f;
+    if (plane && v->iz)
+        chunks(v, lo, hi, 4);
+    else if (plane)
+        chunks(v, lo, hi, 2);
+    else if (v->iz)
+        chunks(v, lo, hi, 3);
+    else
+        chunks(v, lo, hi, 1);
+}
 
 /* Samples [lo, hi); culled: under a culling node that prunes them (only
  * the both visit gets there, for the frustum's lanes). */
 static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
 {
     v->cnt->tested += hi - lo;
+    v->cnt->weighed += culled ? 0 : hi - lo;
+    if (v->fnr) {
+        test_chunks(v, lo, hi);
+        return;
+    }
+    ray16 L;
+    ray16_of(&L, v->r);
+    const soa16 a = soa16_of(v->t);
     if (v->both) {
-        v->cnt->weighed += culled ? 0 : hi - lo;
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
             float z[16], w[16], iz[16];
-            any16 a = {v->zmax, culled, 0, z};
-            uint32_t feas = v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, iz, &a)
-                                             : weigh16(v->t, b, m, v->r, 0, w, iz, &a);
-            if (a.mask | feas)
-                v->fnb(v->ctx, b, m, a.mask, z, feas, w, iz);
+            any16 f = {v->zmax, culled, 0, z};
+            uint32_t feas = v->r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, iz, &f)
+                                             : weigh16(&a, b, m, &L, 0, 1, w, iz, &f);
+            if (f.mask | feas)
+                v->fnb(v->ctx, b, m, f.mask, z, feas, w, iz);
         }
         return;
     }
-    v->cnt->weighed += hi - lo;
     for (uint32_t b = lo; b < hi; b += 16) {
         uint32_t m = hi - b < 16 ? hi - b : 16;
         float w[16], zz[16];
-        uint32_t any =
-            v->r->cap > 0.0f ? weigh16(v->t, b, m, v->r, 1, w, zz, NULL) : weigh16(v->t, b, m, v->r, 0, w, zz, NULL);
+        uint32_t any = v->r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, zz, NULL) : weigh16(&a, b, m, &L, 0, 1, w, zz, NULL);
         if (any)
             v->fn(v->ctx, b, m, any, w, zz);
     }
@@ -552,13 +429,14 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, NULL, NULL, NULL, cnt},
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, 1, NULL, NULL,
+                    NULL, NULL, cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
 
-static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
-                 cdl_skd_visit_both fnb, void *ctx, cdl_skd_count *cnt)
+static int splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
+                       cdl_skd_visit_range fnr, cdl_skd_visit_both fnb, void *ctx, cdl_skd_count *cnt)
 {
     if (!t->n)
         return 0;
@@ -580,7 +458,9 @@ static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int fl
               (flags & CDL_SKD_CULL) != 0,
               (flags & CDL_SKD_SLABS) && !fnb, /* the slabs go front to back, not in tree order */
               fnb != NULL,
+              !(flags & CDL_SKD_NOIZ),
               fn,
+              fnr,
               fnb,
               ctx,
               cnt};
@@ -620,13 +500,19 @@ static int visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int fl
 int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,
                         void *ctx, cdl_skd_count *cnt)
 {
-    return visit(t, part, r, flags, fn, NULL, ctx, cnt);
+    return splat_visit(t, part, r, flags, fn, NULL, NULL, ctx, cnt);
+}
+
+int cdl_skd_splat_visit_range(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags,
+                              cdl_skd_visit_range fn, void *ctx, cdl_skd_count *cnt)
+{
+    return splat_visit(t, part, r, flags, NULL, fn, NULL, ctx, cnt);
 }
 
 int cdl_skd_splat_visit_both(const cdl_skd *t, const cdl_splat_ray *r, int flags, cdl_skd_visit_both fn, void *ctx,
                              cdl_skd_count *cnt)
 {
-    return visit(t, UINT32_MAX, r, flags, NULL, fn, ctx, cnt);
+    return splat_visit(t, UINT32_MAX, r, flags, NULL, NULL, fn, ctx, cnt);
 }
 
 static void append(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *z)

@@ -87,14 +87,14 @@ int splat_maps_init(splat_state *s, cdl_error *err)
 int splat_maps_alloc(splat_state *s, cdl_error *err)
 {
     size_t n = (size_t)s->nslots + 16;
-    if (!s->wsum) {
+    if (!s->nsum) {
         for (int c = 0; c < 3; c++)
             s->E[c] = malloc(sizeof(float) * n);
-        s->wsum = malloc(sizeof(float) * n);
         s->izsum = malloc(sizeof(float) * n);
         s->nsum = malloc(sizeof(float) * n);
         s->gloss = malloc(sizeof(uint32_t) * n);
-        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->wsum || !s->izsum || !s->nsum || !s->gloss)
+        s->gbits = malloc(sizeof(uint32_t) * (n / 32 + 3));
+        if (!s->E[0] || !s->E[1] || !s->E[2] || !s->izsum || !s->nsum || !s->gloss || !s->gbits)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
     uint32_t ng = 0;
@@ -102,6 +102,9 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
         s->gloss[q] = s->eye[q].b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : ng++;
     for (uint32_t q = s->neye; q < s->neye + 16; q++)
         s->gloss[q] = SPLAT_LAMBERT;
+    memset(s->gbits, 0, sizeof(uint32_t) * ((s->neye + 16) / 32 + 3));
+    for (uint32_t q = 0; q < s->neye; q++)
+        s->gbits[q / 32] |= (uint32_t)(s->gloss[q] != SPLAT_LAMBERT) << (q % 32);
     s->nglossy = ng;
     if (ng > s->gcap || !s->gmap) {
         free(s->gmap);
@@ -120,8 +123,9 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
 
 size_t splat_maps_bytes(const splat_state *s)
 {
-    size_t n = s->wsum ? (size_t)s->nslots + 16 : 0;
-    return n * (6 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
+    size_t n = s->nsum ? (size_t)s->nslots + 16 : 0;
+    return (n ? (n / 32 + 3) * sizeof(uint32_t) : 0) +
+           n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
            (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
 }
 
@@ -175,7 +179,6 @@ void splat_maps_add(splat_state *s, splat_terms *t, uint32_t q, float w, float i
     s->E[0][q] += w * flux.x;
     s->E[1][q] += w * flux.y;
     s->E[2][q] += w * flux.z;
-    s->wsum[q] += w;
     s->izsum[q] += iz;
     s->nsum[q] += 1.0f;
     if (s->gloss[q] != SPLAT_LAMBERT)
@@ -190,13 +193,40 @@ typedef struct ray_ctx {
     uint64_t splats, occluded, occl_rays;
 } ray_ctx;
 
-/* The feasible glossy samples of a batch: the ray's light in their maps. */
-static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mask, const float *w)
+/* The feasible glossy samples of a batch (bit i: sample first + i): the
+ * ray's light in their maps. */
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const float *w)
 {
-    for (uint32_t i = 0; i < m; i++) {
-        uint32_t q = first + i, g = c->s->gloss[q];
-        if ((mask >> i & 1u) && g != SPLAT_LAMBERT)
-            add_glossy(c->s, &c->t, q, g, w[i]);
+    splat_state *s = c->s;
+    if (s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) { /* add_glossy's, the stratum's image found once */
+        if (!c->t.ready)
+            splat_terms_of(&c->t, s, c->t.r);
+        float *mp = gmap_at(s, 0, c->t.stratum);
+        const cdl_vec3 flux = c->t.r->flux;
+        for (; glossy; glossy &= glossy - 1) {
+            uint32_t i = (uint32_t)__builtin_ctz(glossy);
+            float *m = mp + 3 * (size_t)s->gloss[first + i];
+            m[0] += w[i] * flux.x;
+            m[1] += w[i] * flux.y;
+            m[2] += w[i] * flux.z;
+        }
+        return;
+    }
+    if (s->opt.splat.mode == CDL_SPLAT_SH) { /* add_glossy's, inline */
+        if (!c->t.ready)
+            splat_terms_of(&c->t, s, c->t.r);
+        const float *sh = c->t.sh;
+        for (; glossy; glossy &= glossy - 1) {
+            uint32_t i = (uint32_t)__builtin_ctz(glossy);
+            float *m = gmap_at(s, s->gloss[first + i], 0), wi = w[i];
+            for (int k = 0; k < CDL_SH_N * 3; k++)
+                m[k] += wi * sh[k];
+        }
+        return;
+    }
+    for (; glossy; glossy &= glossy - 1) {
+        uint32_t i = (uint32_t)__builtin_ctz(glossy), q = first + i;
+        add_glossy(c->s, &c->t, q, c->s->gloss[q], w[i]);
     }
 }
 
@@ -220,12 +250,16 @@ static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mas
     }
 }
 
-/* A batch of samples from the tree (or a ray's kept splats, with the
- * visibility mask): every feasible one gets the ray's irradiance, 16 lanes at a time (lanes past m belong to the next leaf,
- * perhaps another thread's: masked); glossy ones their map entries too. */
-static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, const float *w, const float *iz)
+/* A batch of 16 lanes from the tree (or a ray's kept splats, with the
+ * visibility mask): every feasible one gets the ray's irradiance, glossy
+ * ones their map entries too. whole: all 16 lanes are this part's (plain
+ * loads and stores); else lanes past m, or outside the mask, may be
+ * another thread's and are left alone. izsum is the cache's
+ * (splat_maps_add): iz is read only by the occlusion test and the
+ * bandwidth picture. */
+static void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole, uint32_t mask, const float *w,
+                        const float *iz)
 {
-    ray_ctx *c = ctx;
     splat_state *s = c->s;
     if (s->occl) {
         uint32_t seen = splat_occl_filter(s, c->t.r, first, mask, iz, &c->occl_rays);
@@ -234,43 +268,47 @@ static void splat_batch(void *ctx, uint32_t first, uint32_t m, uint32_t mask, co
             return;
     }
     float *er = s->E[0] + first, *eg = s->E[1] + first, *eb = s->E[2] + first;
-    float *ws = s->wsum + first, *zs = s->izsum + first, *ns = s->nsum + first;
-    const uint32_t *gl = s->gloss + first;
+    float *ns = s->nsum + first;
+    /* the splat counts are the filter's only (the cache counts its own) */
+    const int count = s->opt.splat.filter > 0.0f;
+    uint64_t gb;
+    memcpy(&gb, s->gbits + first / 32, sizeof gb);
+    const uint32_t glossy = (uint32_t)(gb >> (first % 32)) & mask;
 #if defined(__AVX512F__)
     const __mmask16 k = (__mmask16)mask;
     const __m512 wv = _mm512_loadu_ps(w);
     const cdl_vec3 flux = c->t.r->flux;
-    _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
-    _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
-    _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
-    _mm512_mask_storeu_ps(ws, k, _mm512_add_ps(wv, _mm512_maskz_loadu_ps(k, ws)));
-    _mm512_mask_storeu_ps(zs, k, _mm512_add_ps(_mm512_loadu_ps(iz), _mm512_maskz_loadu_ps(k, zs)));
-    _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
-    uint32_t glossy = _mm512_mask_cmpneq_epi32_mask(k, _mm512_maskz_loadu_epi32(k, gl), _mm512_set1_epi32(-1));
+    if (whole) { /* unfed lanes rewritten unchanged */
+        _mm512_storeu_ps(er, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_loadu_ps(er), k));
+        _mm512_storeu_ps(eg, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_loadu_ps(eg), k));
+        _mm512_storeu_ps(eb, _mm512_mask3_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_loadu_ps(eb), k));
+    } else {
+        _mm512_mask_storeu_ps(er, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.x), _mm512_maskz_loadu_ps(k, er)));
+        _mm512_mask_storeu_ps(eg, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.y), _mm512_maskz_loadu_ps(k, eg)));
+        _mm512_mask_storeu_ps(eb, k, _mm512_fmadd_ps(wv, _mm512_set1_ps(flux.z), _mm512_maskz_loadu_ps(k, eb)));
+    }
+    if (count)
+        _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     c->splats += (uint64_t)__builtin_popcount(mask);
 #else
     const float fr = c->t.r->flux.x, fg = c->t.r->flux.y, fb = c->t.r->flux.z;
-    uint32_t glossy = 0;
     for (uint32_t i = 0; i < m; i++) {
         if (!(mask >> i & 1u))
             continue;
         er[i] += w[i] * fr;
         eg[i] += w[i] * fg;
         eb[i] += w[i] * fb;
-        ws[i] += w[i];
-        zs[i] += iz[i];
-        ns[i] += 1.0f;
-        glossy |= gl[i] != SPLAT_LAMBERT;
+        ns[i] += count ? 1.0f : 0.0f;
         c->splats++;
     }
 #endif
     if (glossy)
-        splat_glossy(c, first, m, mask, w);
+        splat_glossy(c, first, glossy, w);
     if (s->want_bw)
         splat_bandwidth(c, first, m, mask, w, iz);
 }
 
-/* With the visibility mask: ray's kept splats, in ray order. */
+/* With the visibility mask: a ray's kept splats, in ray order. */
 static void replay_batch(void *ctx, uint32_t ray, uint32_t first, uint32_t mask, const float *w, const float *iz)
 {
     ray_ctx *c = ctx;
@@ -279,7 +317,18 @@ static void replay_batch(void *ctx, uint32_t ray, uint32_t first, uint32_t mask,
         c->t.r = &c->s->rays.r[ray];
         c->t.ready = 0;
     }
-    splat_batch(c, first, 16, mask, w, iz);
+    splat_batch(c, first, 16, 0, mask, w, iz);
+}
+
+/* A leaf range from the tree: its 16-lane blocks with feasible samples,
+ * without a call each. */
+static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
+{
+    for (uint32_t j = 0; j * 16 < n; j++)
+        if (mask[j]) {
+            uint32_t m = n - 16 * j < 16 ? n - 16 * j : 16;
+            splat_batch(ctx, first + 16 * j, m, m == 16, mask[j], w + 16 * j, iz + 16 * j);
+        }
 }
 
 void splat_maps_clear(splat_state *s)
@@ -287,7 +336,6 @@ void splat_maps_clear(splat_state *s)
     size_t n = (size_t)s->neye + 16;
     for (int c = 0; c < 3; c++)
         memset(s->E[c], 0, sizeof(float) * n);
-    memset(s->wsum, 0, sizeof(float) * n);
     memset(s->izsum, 0, sizeof(float) * n);
     memset(s->nsum, 0, sizeof(float) * n);
     memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
@@ -299,7 +347,8 @@ int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
     uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0;
-    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0);
+    const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0) |
+                      (s->mask || s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
     /* with visibility masks, a batch of rays at a time: one traversal per
      * ray builds its mask and keeps the splats it lets through, which the
      * parts then replay */
@@ -325,7 +374,7 @@ int splat_maps_splat(splat_state *s)
                 c.t.r = r;
                 c.t.ready = 0;
                 c.ray = k;
-                cdl_skd_splat_visit(&s->tree, part, &sr, flags, splat_batch, &c, &cnt);
+                cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, splat_range, &c, &cnt);
             }
             splats += c.splats;
             occluded += c.occluded;

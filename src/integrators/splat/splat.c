@@ -280,7 +280,9 @@ static int eye_pass(splat_state *s, uint32_t pass, int y0, int y1, uint64_t *ray
     /* the valid slots, in slot order, become the eye samples */
     uint32_t n = 0, nk = (uint32_t)(y1 - y0) * (uint32_t)s->opt.camera.width * s->opt.splat.eye_samples * s->G;
     for (uint32_t k = 0; k < nk; k++)
-        if (s->svalid[k]) {
+        if (s->svalid[k] && n == k) { /* in place until the first invalid one */
+            n++;
+        } else if (s->svalid[k]) {
             s->slot[n] = s->slot[k];
             s->sp[n] = s->sp[k];
             s->sn[n] = s->sn[k];
@@ -595,8 +597,8 @@ static void splat_destroy(void *self)
     free(s->pix);
     for (int c = 0; c < 3; c++)
         free(s->E[c]);
-    free(s->wsum);
     free(s->izsum);
+    free(s->gbits);
     free(s->nsum);
     free(s->gloss);
     free(s->gmap);

@@ -65,8 +65,9 @@ typedef struct splat_state {
      * Lambertian sample needs nothing else in any mode (its BSDF is one
      * constant: kd / pi E; its SH table holds only the DC term); the others
      * (gloss[q] != SPLAT_LAMBERT) get K x 3 floats in gmap. */
-    float *E[3], *wsum, *izsum, *nsum; /* nsum: splats received */
+    float *E[3], *izsum, *nsum; /* splats received: sum of 1 / z (the cache's), count */
     uint32_t *gloss;  /* index into gmap, or SPLAT_LAMBERT */
+    uint32_t *gbits;  /* bit q % 32 of word q / 32: gloss[q] != SPLAT_LAMBERT (words to spare past the end) */
     float *gmap;      /* histogram: [stratum][glossy sample][3]; SH: [glossy sample][k][3]; direct: [g][3] */
     uint32_t nglossy, gcap;
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
