@@ -291,6 +291,7 @@ static void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole, uint3
         _mm512_mask_storeu_ps(ns, k, _mm512_add_ps(_mm512_set1_ps(1.0f), _mm512_maskz_loadu_ps(k, ns)));
     c->splats += (uint64_t)__builtin_popcount(mask);
 #else
+    (void)whole; /* the loop below touches fed lanes only */
     const float fr = c->t.r->flux.x, fg = c->t.r->flux.y, fb = c->t.r->flux.z;
     for (uint32_t i = 0; i < m; i++) {
         if (!(mask >> i & 1u))
