@@ -12,6 +12,16 @@
 #include <immintrin.h>
 #endif
 
+/* The sample arrays (the tree's, or any laid out alike). */
+typedef struct soa16 {
+    const float *p[3], *n[3], *two;
+} soa16;
+
+static inline soa16 soa16_of(const cdl_skd *t)
+{
+    return (soa16){{t->p[0], t->p[1], t->p[2]}, {t->nrm[0], t->nrm[1], t->nrm[2]}, t->two};
+}
+
 /* The both visit's frustum test, on the way (see cdl_skd_visit_both):
  * lanes inside the frustum up to zmax and their z; culled: the leaf test
  * is not wanted. */
@@ -53,16 +63,6 @@ static inline void ray16_of(ray16 *L, const cdl_splat_ray *r)
     L->zmin = _mm512_set1_ps(r->zmin), L->otol = _mm512_set1_ps(r->otol), L->cap = _mm512_set1_ps(r->cap);
     L->xlen = _mm512_set1_ps(r->len * 1.0001f);
     L->otol_on = r->otol > 0.0f;
-}
-
-/* The sample arrays (the tree's, or any laid out alike). */
-typedef struct soa16 {
-    const float *p[3], *n[3], *two;
-} soa16;
-
-static inline soa16 soa16_of(const cdl_skd *t)
-{
-    return (soa16){{t->p[0], t->p[1], t->p[2]}, {t->nrm[0], t->nrm[1], t->nrm[2]}, t->two};
 }
 
 /* wiz: whether zz is wanted (else left unwritten). */
@@ -153,15 +153,6 @@ typedef struct ray16 {
 } ray16;
 
 static inline void ray16_of(ray16 *L, const cdl_splat_ray *r) { L->r = *r; }
-
-typedef struct soa16 {
-    const float *p[3], *n[3], *two;
-} soa16;
-
-static inline soa16 soa16_of(const cdl_skd *t)
-{
-    return (soa16){{t->p[0], t->p[1], t->p[2]}, {t->nrm[0], t->nrm[1], t->nrm[2]}, t->two};
-}
 
 static inline uint32_t weigh16(const soa16 *t, uint32_t b, uint32_t m, const ray16 *L, int plane, int wiz, float *w,
                                float *zz, any16 *a)

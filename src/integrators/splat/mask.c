@@ -428,7 +428,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
 #pragma omp for schedule(dynamic, 16)
         for (uint32_t k = 0; k < n; k++)
             build_ray(s, wid, k, flags, &c);
-#pragma omp critical(splat_mask_count)
+#pragma omp critical
         {
             bc.tested += c.tested, bc.weighed += c.weighed, bc.nodes += c.nodes;
             bc.rasterized += c.rasterized, bc.masks += c.masks, bc.buffers += c.buffers, bc.masked += c.masked;

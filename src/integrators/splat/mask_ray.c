@@ -194,6 +194,22 @@ static bound bound_of(const mask_ray *x, const mask_feas *f, uint32_t nf, float 
 
 #define BOUNDS 8 /* distinct hider normals a ray may meet before it just builds its buffer */
 
+/* The bound of normal n among the *nb made so far, made if new; -1 past
+ * BOUNDS. */
+static int bound_find(bound *bd, int *nb, const mask_ray *x, const mask_feas *f, uint32_t nf, float nx, float ny,
+                      float nz)
+{
+    int e = 0;
+    while (e < *nb && !(bd[e].n[0] == nx && bd[e].n[1] == ny && bd[e].n[2] == nz))
+        e++;
+    if (e == *nb) {
+        if (*nb == BOUNDS)
+            return -1;
+        bd[(*nb)++] = bound_of(x, f, nf, nx, ny, nz);
+    }
+    return e;
+}
+
 /* The filter hides feasible y behind front sample o when o is nearer by
  * more than pw_y, the origin lies off o's plane by more than pw_o and y
  * lies behind it by more than pw_y: (p_y - p_o) . n_o < -pw_y with the
@@ -221,14 +237,9 @@ int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, cons
             same = _mm512_mask_cmp_ps_mask(same, l.nz, _mm512_set1_ps(nz), _CMP_EQ_OQ);
             if (!(same >> i & 1u))
                 return 1; /* not a number */
-            int e = 0;
-            while (e < nb && !(bd[e].n[0] == nx && bd[e].n[1] == ny && bd[e].n[2] == nz))
-                e++;
-            if (e == nb) {
-                if (nb == BOUNDS)
-                    return 1;
-                bd[nb++] = bound_of(x, f, nf, nx, ny, nz);
-            }
+            int e = bound_find(bd, &nb, x, f, nf, nx, ny, nz);
+            if (e < 0)
+                return 1;
             __m512 d = dot16(l.px, l.py, l.pz, nx, ny, nz);
             __mmask16 front = _mm512_mask_cmp_ps_mask(same, l.so, _mm512_set1_ps(eps), _CMP_LT_OQ);
             __mmask16 back = _mm512_mask_cmp_ps_mask(same, l.so, _mm512_set1_ps(-eps), _CMP_GT_OQ);
@@ -247,14 +258,9 @@ int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, cons
                 continue;
             if (!(nx == nx && ny == ny && nz == nz))
                 return 1;
-            int e = 0;
-            while (e < nb && !(bd[e].n[0] == nx && bd[e].n[1] == ny && bd[e].n[2] == nz))
-                e++;
-            if (e == nb) {
-                if (nb == BOUNDS)
-                    return 1;
-                bd[nb++] = bound_of(x, f, nf, nx, ny, nz);
-            }
+            int e = bound_find(bd, &nb, x, f, nf, nx, ny, nz);
+            if (e < 0)
+                return 1;
             float d = t->p[0][q] * nx + t->p[1][q] * ny + t->p[2][q] * nz;
             if ((so < eps && bd[e].lo < d + eps) || (so > -eps && bd[e].hi > d - eps))
                 return 1;
