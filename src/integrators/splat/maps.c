@@ -99,7 +99,7 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
     }
     uint32_t ng = 0;
     for (uint32_t q = 0; q < s->neye; q++)
-        s->gloss[q] = s->eye[q].b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : ng++;
+        s->gloss[q] = s->eye[q].bsdf == SPLAT_LAMBERT ? SPLAT_LAMBERT : ng++;
     for (uint32_t q = s->neye; q < s->neye + 16; q++)
         s->gloss[q] = SPLAT_LAMBERT;
     memset(s->gbits, 0, sizeof(uint32_t) * ((s->neye + 16) / 32 + 3));
@@ -108,11 +108,19 @@ int splat_maps_alloc(splat_state *s, cdl_error *err)
     s->nglossy = ng;
     if (ng > s->gcap || !s->gmap) {
         free(s->gmap);
+        free(s->gb);
         s->gcap = ng > s->gcap ? ng + ng / 8 : s->gcap;
         s->gmap = malloc(sizeof(float) * 3 * s->K * (s->gcap ? s->gcap : 1));
-        if (!s->gmap)
+        s->gb = malloc(sizeof *s->gb * (s->gcap ? s->gcap : 1));
+        if (!s->gmap || !s->gb)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the radiance maps");
     }
+    /* the glossy samples' BSDFs in tree order: splats and the resolve
+     * read them there */
+#pragma omp parallel for schedule(static)
+    for (uint32_t q = 0; q < s->neye; q++)
+        if (s->gloss[q] != SPLAT_LAMBERT)
+            s->gb[s->gloss[q]] = s->sb[s->eye[q].bsdf];
     if (s->want_bw && !s->bw) {
         s->bw = malloc(sizeof(float) * SPLAT_BW * n);
         if (!s->bw)
@@ -126,7 +134,7 @@ size_t splat_maps_bytes(const splat_state *s)
     size_t n = s->nsum ? (size_t)s->nslots + 16 : 0;
     return (n ? (n / 32 + 3) * sizeof(uint32_t) : 0) +
            n * (5 * sizeof(float) + sizeof(uint32_t) + (s->bw ? SPLAT_BW * sizeof(float) : 0)) +
-           (s->gmap ? (size_t)s->gcap * s->K * 3 * sizeof(float) : 0);
+           (s->gmap ? (size_t)s->gcap * (s->K * 3 * sizeof(float) + sizeof(cdl_bsdf)) : 0);
 }
 
 void splat_terms_of(splat_terms *t, const splat_state *s, const cdl_photon_ray *r)
@@ -164,8 +172,7 @@ static void add_glossy(splat_state *s, splat_terms *t, uint32_t q, uint32_t g, f
         mp[1] += w * flux.y;
         mp[2] += w * flux.z;
     } else {
-        const splat_eye *ey = &s->eye[q];
-        cdl_vec3 f = cdl_bsdf_eval(&ey->b, ey->wo, t->wi, 0);
+        cdl_vec3 f = cdl_bsdf_eval(&s->gb[g], s->eye[q].wo, t->wi, 0);
         float *mp = gmap_at(s, g, 0);
         mp[0] += w * f.x * flux.x;
         mp[1] += w * f.y * flux.y;
@@ -411,7 +418,7 @@ void splat_maps_resolve(splat_state *s)
         const uint32_t g = s->gloss[q];
         cdl_vec3 L;
         if (g == SPLAT_LAMBERT) {
-            L = cdl_mul(cdl_scale(e->b.kd, (float)CDL_INV_PI), cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
+            L = cdl_mul(cdl_scale(e->kd, (float)CDL_INV_PI), cdl_v3(s->E[0][q], s->E[1][q], s->E[2][q]));
         } else if (mode == CDL_SPLAT_DIRECT) {
             const float *m = gmap_at(s, g, 0);
             L = cdl_v3(m[0], m[1], m[2]);
@@ -423,12 +430,12 @@ void splat_maps_resolve(splat_state *s)
                 if (cdl_is_black(Ek))
                     continue;
                 cdl_vec3 wi = above(s->strata[k], e->f.n);
-                L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&e->b, e->wo, wi, 0), Ek));
+                L = cdl_add(L, cdl_mul(cdl_bsdf_eval(&s->gb[g], e->wo, wi, 0), Ek));
             }
         } else {
             float loc[CDL_SH_N * 3], c[CDL_SH_N * 3];
             cdl_sh_rotate(&s->rot, e->f, gmap_at(s, g, 0), loc, 3);
-            cdl_bsdf_sh_lookup(&s->tables[e->mat], cdl_dot(e->wo, e->f.n), e->b.kd, c);
+            cdl_bsdf_sh_lookup(&s->tables[e->mat], cdl_dot(e->wo, e->f.n), e->kd, c);
             float acc[3] = {0.0f, 0.0f, 0.0f};
             for (int k = 0; k < CDL_SH_N; k++)
                 for (int ch = 0; ch < 3; ch++)

@@ -129,11 +129,12 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
     s->dn = calloc(npix, sizeof *s->dn);
     s->pix = calloc(npix, sizeof *s->pix);
     s->slot = malloc(sizeof *s->slot * s->nslots);
+    s->sb = malloc(sizeof *s->sb * s->nslots);
     s->sp = malloc(sizeof *s->sp * s->nslots);
     s->sn = malloc(sizeof *s->sn * s->nslots);
     s->sflags = malloc(s->nslots);
     s->svalid = malloc(s->nslots);
-    if (!s->base || !s->dz || !s->dn || !s->pix || !s->slot || !s->sp || !s->sn || !s->sflags || !s->svalid)
+    if (!s->base || !s->dz || !s->dn || !s->pix || !s->slot || !s->sb || !s->sp || !s->sn || !s->sflags || !s->svalid)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for %u eye samples", s->nslots);
     return splat_maps_init(s, err);
 }
@@ -142,7 +143,10 @@ static int splat_prepare(void *self, const cdl_scene *scene, const cdl_options *
 static void fill_slot(splat_state *s, uint32_t k, const cdl_visible *v, cdl_vec3 weight, uint32_t p, float pw)
 {
     splat_eye *e = &s->slot[k];
-    e->b = v->b;
+    e->kd = v->b.kd;
+    e->bsdf = v->b.type == CDL_MAT_DIFFUSE ? SPLAT_LAMBERT : k;
+    if (e->bsdf != SPLAT_LAMBERT)
+        s->sb[k] = v->b;
     e->weight = weight;
     e->wo = v->wo;
     e->pixel = p;
@@ -301,7 +305,7 @@ static int build(splat_state *s, cdl_error *err)
         return err->code;
     if (!s->eye && !(s->eye = malloc(sizeof *s->eye * (s->nslots ? s->nslots : 1))))
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the eye samples");
-    /* 336-byte records gathered from all over: in parallel */
+    /* records gathered from all over: in parallel */
 #pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < s->neye; q++)
         s->eye[q] = s->slot[s->tree.order[q]];
@@ -380,7 +384,9 @@ static int sort_rays(splat_state *s, cdl_error *err)
 
 static size_t bytes(const splat_state *s)
 {
-    return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + splat_maps_bytes(s) +
+    /* sb: the pages of the non-Lambertian samples' slots (about gcap) */
+    return (size_t)s->nslots * (2 * sizeof(splat_eye) + 2 * sizeof(cdl_vec3) + 2) + (size_t)s->gcap * sizeof(cdl_bsdf) +
+           splat_maps_bytes(s) +
            cdl_skd_bytes(&s->tree) + (size_t)s->rays.cap * sizeof(cdl_photon_ray) +
            splat_mask_bytes(s) + splat_occl_bytes(s) +
            (size_t)s->opt.camera.width * s->opt.camera.height * 2 * sizeof(cdl_vec3);
@@ -591,6 +597,8 @@ static void splat_destroy(void *self)
     free(s->svalid);
     free(s->slot);
     free(s->eye);
+    free(s->sb);
+    free(s->gb);
     free(s->base);
     free(s->dz);
     free(s->dn);

@@ -20,12 +20,13 @@
 /* An eye sample (§3): what the final step needs besides the tree's
  * position and normal. */
 typedef struct splat_eye {
-    cdl_bsdf b;
+    cdl_vec3 kd;     /* the BSDF's reflectance (all a Lambertian sample needs) */
     cdl_vec3 weight; /* the specular chain's weight / eye samples per pixel */
     cdl_vec3 wo;     /* towards the camera */
     cdl_frame f;     /* shading normal on the seen side; t towards wo (SH tables) */
     uint32_t pixel, mat;
     float pw;        /* a pixel's width in the world at the sample (along its chain) */
+    uint32_t bsdf;   /* slot of its BSDF in splat_state.sb, SPLAT_LAMBERT for a Lambertian one */
 } splat_eye;
 
 typedef struct splat_stats {
@@ -50,6 +51,10 @@ typedef struct splat_state {
     cdl_vec3 *sp, *sn;
     uint8_t *sflags, *svalid;
     splat_eye *slot, *eye;
+    /* The BSDFs of the non-Lambertian samples, by slot (written only
+     * there: 264 bytes a sample would be most of the memory and of the
+     * gather into tree order), and gathered by glossy index (gb[gloss[q]]) */
+    cdl_bsdf *sb, *gb;
     uint32_t nslots, neye;
     uint32_t G;       /* eye samples per camera sample: gather rays, or 1 */
     int band_rows;    /* rows per band (the whole image without gather) */
@@ -69,7 +74,7 @@ typedef struct splat_state {
     uint32_t *gloss;  /* index into gmap, or SPLAT_LAMBERT */
     uint32_t *gbits;  /* bit q % 32 of word q / 32: gloss[q] != SPLAT_LAMBERT (words to spare past the end) */
     float *gmap;      /* histogram: [stratum][glossy sample][3]; SH: [glossy sample][k][3]; direct: [g][3] */
-    uint32_t nglossy, gcap;
+    uint32_t nglossy, gcap; /* gmap and gb have room for gcap */
     uint32_t K;       /* 1 (direct), 20 (histogram), 16 (SH) */
     float *bw;        /* aov bandwidth only: SPLAT_BW floats per sample */
     struct splat_cache *cache; /* cache: radiance caching (cache.c) */
