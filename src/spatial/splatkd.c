@@ -20,31 +20,88 @@ void cdl_skd_params_default(cdl_skd_params *p, float scene_diag)
 }
 
 typedef struct builder {
-    cdl_skd *t;
     const cdl_skd_params *prm;
     uint32_t *idx; /* caller's indices, permuted in place */
     const cdl_vec3 *p, *n;
     const uint8_t *flags;
     uint32_t cull_below; /* subtrees smaller than this may get a culling node */
     float cos_cull;
-    int fail;
 } builder;
 
-static uint32_t push(builder *b, uint32_t a, uint32_t w)
+/* What the build of a subtree produces: its nodes (right children
+ * indexed from its first), parts and counts. The two halves of a large
+ * split are built as tasks into their own and appended in depth-first
+ * order, so the tree is the serial build's whatever the threads. */
+typedef struct sub {
+    cdl_skd_node *nodes;
+    uint32_t n, cap;
+    cdl_skd_part *parts;
+    uint32_t nparts, pcap;
+    uint32_t leaves, culls, empties, depth;
+    int fail;
+} sub;
+
+/* Halves at least this large are built as tasks. */
+#define TASK_MIN 32768u
+
+static uint32_t push(sub *o, uint32_t a, uint32_t w)
 {
-    cdl_skd *t = b->t;
-    if (t->nnodes == t->cap) {
-        uint32_t cap = t->cap ? 2 * t->cap : 1024;
-        cdl_skd_node *nn = cap < MAX_INDEX ? realloc(t->nodes, sizeof *nn * cap) : NULL;
+    if (o->n == o->cap) {
+        uint32_t cap = o->cap ? 2 * o->cap : 1024;
+        cdl_skd_node *nn = cap < MAX_INDEX ? realloc(o->nodes, sizeof *nn * cap) : NULL;
         if (!nn) {
-            b->fail = 1;
+            o->fail = 1;
             return 0;
         }
-        t->nodes = nn;
-        t->cap = cap;
+        o->nodes = nn;
+        o->cap = cap;
     }
-    t->nodes[t->nnodes] = (cdl_skd_node){a, w};
-    return t->nnodes++;
+    o->nodes[o->n] = (cdl_skd_node){a, w};
+    return o->n++;
+}
+
+static void add_part(sub *o, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
+{
+    if (o->nparts == o->pcap) {
+        uint32_t cap = o->pcap ? 2 * o->pcap : 8;
+        cdl_skd_part *np = realloc(o->parts, sizeof *np * cap);
+        if (!np) {
+            o->fail = 1;
+            return;
+        }
+        o->parts = np;
+        o->pcap = cap;
+    }
+    cdl_skd_part *p = &o->parts[o->nparts++];
+    p->node = node;
+    p->lo = lo;
+    p->hi = hi;
+    memcpy(p->bmin, mn, sizeof p->bmin);
+    memcpy(p->bmax, mx, sizeof p->bmax);
+}
+
+/* src after dst's nodes (its right-child and part indices moved along);
+ * src is freed. */
+static void append(sub *dst, sub *src)
+{
+    uint32_t base = dst->n;
+    dst->fail |= src->fail;
+    if (!dst->fail && (uint64_t)base + src->n >= MAX_INDEX)
+        dst->fail = 1;
+    for (uint32_t i = 0; i < src->n && !dst->fail; i++) {
+        cdl_skd_node nd = src->nodes[i];
+        push(dst, nd.a, (nd.b & 3) == 3 ? nd.b : nd.b + (base << 2));
+    }
+    for (uint32_t i = 0; i < src->nparts && !dst->fail; i++) {
+        const cdl_skd_part *p = &src->parts[i];
+        add_part(dst, base + p->node, p->lo, p->hi, p->bmin, p->bmax);
+    }
+    dst->leaves += src->leaves;
+    dst->culls += src->culls;
+    dst->empties += src->empties;
+    dst->depth = src->depth > dst->depth ? src->depth : dst->depth;
+    free(src->nodes);
+    free(src->parts);
 }
 
 static float pc(const builder *b, uint32_t i, int a)
@@ -55,7 +112,7 @@ static float pc(const builder *b, uint32_t i, int a)
 
 /* A culling node over idx[lo, hi) if every normal lies within the cone
  * limit of their mean; returns 1 if one was pushed. */
-static int try_cull(builder *b, uint32_t lo, uint32_t hi)
+static int try_cull(const builder *b, sub *o, uint32_t lo, uint32_t hi)
 {
     cdl_vec3 m = cdl_v3(0.0f, 0.0f, 0.0f);
     for (uint32_t i = lo; i < hi; i++) {
@@ -78,45 +135,46 @@ static int try_cull(builder *b, uint32_t lo, uint32_t hi)
     /* C_max = sin(D_theta), a little larger for rounding, quantized upwards */
     double s = sqrt(fmax(0.0, 1.0 - (double)cmin * cmin)) + 1e-4;
     uint32_t q = (uint32_t)ceil((s < 1.0 ? s : 1.0) * 65535.0);
-    push(b, code, 3u | (uint32_t)KIND_CULL << 2 | q << 16);
+    push(o, code, 3u | (uint32_t)KIND_CULL << 2 | q << 16);
     return 1;
 }
 
-static void add_part(cdl_skd *t, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
+static void build(const builder *b, sub *o, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled,
+                  uint32_t depth, int in_part);
+
+/* One half of a split as a task of its own (mn, mx copied: the caller
+ * goes on with its own). */
+static void build_task(const builder *b, sub *o, uint32_t lo, uint32_t hi, const float *mn, const float *mx,
+                       int culled, uint32_t depth, int in_part)
 {
-    cdl_skd_part *p = &t->parts[t->nparts++];
-    p->node = node;
-    p->lo = lo;
-    p->hi = hi;
-    memcpy(p->bmin, mn, sizeof p->bmin);
-    memcpy(p->bmax, mx, sizeof p->bmax);
+    float cmn[3] = {mn[0], mn[1], mn[2]}, cmx[3] = {mx[0], mx[1], mx[2]};
+    build(b, o, lo, hi, cmn, cmx, culled, depth, in_part);
 }
 
 /* The subtree over idx[lo, hi) in the cell [mn, mx], `depth` splits below
  * the root. A part is the subtree at depth part_depth, or a shallower one
  * that does not split (a leaf, an empty node) or starts with a culling
  * node; in_part: an ancestor is one. */
-static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled, uint32_t depth,
-                  int in_part)
+static void build(const builder *b, sub *o, uint32_t lo, uint32_t hi, float *mn, float *mx, int culled,
+                  uint32_t depth, int in_part)
 {
-    cdl_skd *t = b->t;
-    if (b->fail)
+    if (o->fail)
         return;
-    if (depth > t->depth)
-        t->depth = depth;
-    uint32_t first = t->nnodes;
+    if (depth > o->depth)
+        o->depth = depth;
+    uint32_t first = o->n;
     if (lo == hi) {
         if (!in_part)
-            add_part(t, first, lo, hi, mn, mx);
-        push(b, 0, 3u | (uint32_t)KIND_EMPTY << 2);
-        t->empties++;
+            add_part(o, first, lo, hi, mn, mx);
+        push(o, 0, 3u | (uint32_t)KIND_EMPTY << 2);
+        o->empties++;
         return;
     }
-    if (!culled && b->cos_cull > -2.0f && hi - lo < b->cull_below && try_cull(b, lo, hi)) {
+    if (!culled && b->cos_cull > -2.0f && hi - lo < b->cull_below && try_cull(b, o, lo, hi)) {
         culled = 1;
-        t->culls++;
+        o->culls++;
         if (!in_part) {
-            add_part(t, first, lo, hi, mn, mx);
+            add_part(o, first, lo, hi, mn, mx);
             in_part = 1;
         }
     }
@@ -173,30 +231,39 @@ static void build(builder *b, uint32_t lo, uint32_t hi, float *mn, float *mx, in
         }
     }
     if (!in_part && (axis < 0 || depth == b->prm->part_depth)) {
-        add_part(t, first, lo, hi, mn, mx);
+        add_part(o, first, lo, hi, mn, mx);
         in_part = 1;
     }
     if (axis < 0) {
-        push(b, hi - lo, 3u | (uint32_t)KIND_LEAF << 2 | lo << 4);
-        t->leaves++;
+        push(o, hi - lo, 3u | (uint32_t)KIND_LEAF << 2 | lo << 4);
+        o->leaves++;
         return;
     }
-    uint32_t node = push(b, fbits(split), (uint32_t)axis);
-    float keep = mx[axis];
-    mx[axis] = split;
-    build(b, lo, mid, mn, mx, culled, depth + 1, in_part);
-    mx[axis] = keep;
-    if (b->fail)
-        return;
-    if (t->nnodes >= MAX_INDEX) {
-        b->fail = 1;
+    uint32_t node = push(o, fbits(split), (uint32_t)axis);
+    float lmx[3] = {mx[0], mx[1], mx[2]}, rmn[3] = {mn[0], mn[1], mn[2]};
+    lmx[axis] = split;
+    rmn[axis] = split;
+    if (mid - lo >= TASK_MIN && hi - mid >= TASK_MIN) {
+        sub l = {0}, r = {0};
+#pragma omp task default(shared)
+        build_task(b, &l, lo, mid, mn, lmx, culled, depth + 1, in_part);
+        build_task(b, &r, mid, hi, rmn, mx, culled, depth + 1, in_part);
+#pragma omp taskwait
+        append(o, &l);
+        if (!o->fail)
+            o->nodes[node].b |= o->n << 2;
+        append(o, &r);
         return;
     }
-    t->nodes[node].b |= t->nnodes << 2;
-    keep = mn[axis];
-    mn[axis] = split;
-    build(b, mid, hi, mn, mx, culled, depth + 1, in_part);
-    mn[axis] = keep;
+    build(b, o, lo, mid, mn, lmx, culled, depth + 1, in_part);
+    if (o->fail)
+        return;
+    if (o->n >= MAX_INDEX) {
+        o->fail = 1;
+        return;
+    }
+    o->nodes[node].b |= o->n << 2;
+    build(b, o, mid, hi, rmn, mx, culled, depth + 1, in_part);
 }
 
 /* The bounding sphere of every node below `node` (lsph: centre and
@@ -285,8 +352,7 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
         t->p[a] = calloc(m + 16, sizeof(float));
         t->nrm[a] = calloc(m + 16, sizeof(float));
     }
-    t->parts = malloc(sizeof(cdl_skd_part) << prm->part_depth);
-    int ok = t->order && t->two && t->parts;
+    int ok = t->order && t->two;
     for (int a = 0; a < 3; a++)
         ok = ok && t->p[a] && t->nrm[a];
     if (!ok) {
@@ -296,7 +362,7 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
     t->n = n_samples;
     for (uint32_t i = 0; i < n_samples; i++)
         t->order[i] = i;
-    builder b = {t, prm, t->order, p, n, flags, 0, -3.0f, 0};
+    builder b = {prm, t->order, p, n, flags, 0, -3.0f};
     if (prm->cull_deg >= 0.0f) {
         b.cos_cull = cosf(prm->cull_deg * (float)(CDL_PI / 180.0));
         b.cull_below = (uint32_t)ceil(sqrt((double)n_samples)); /* 2^(0.5 log2 N) */
@@ -304,11 +370,25 @@ int cdl_skd_build(cdl_skd *t, const cdl_vec3 *p, const cdl_vec3 *n, const uint8_
     float bmn[3], bmx[3];
     memcpy(bmn, mn, sizeof bmn);
     memcpy(bmx, mx, sizeof bmx);
-    build(&b, 0, n_samples, bmn, bmx, 0, 0, 0);
-    if (b.fail) {
+    sub o = {0};
+#pragma omp parallel if (n_samples >= 2 * TASK_MIN)
+#pragma omp single
+    build(&b, &o, 0, n_samples, bmn, bmx, 0, 0, 0);
+    free(t->parts);
+    t->nodes = o.nodes;
+    t->nnodes = o.n;
+    t->cap = o.cap;
+    t->parts = o.parts;
+    t->nparts = o.nparts;
+    t->leaves = o.leaves;
+    t->culls = o.culls;
+    t->empties = o.empties;
+    t->depth = o.depth;
+    if (o.fail || !t->parts) {
         cdl_skd_free(t);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "", 0, "out of memory for the splat kd-tree");
     }
+#pragma omp parallel for schedule(static) if (n_samples >= 2 * TASK_MIN)
     for (uint32_t i = 0; i < n_samples; i++) {
         uint32_t s = t->order[i];
         const float *v = &p[s].x, *w = &n[s].x;
