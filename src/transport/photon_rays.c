@@ -100,6 +100,7 @@ typedef struct trace_ctx {
     uint64_t seed;
     uint32_t pass;
     double base[CDL_PRAY_CATS]; /* C / M_c^(1/6) */
+    int caustic_only; /* the indirect budget is full: no ray past a path's first diffuse vertex is taken */
 } trace_ctx;
 
 static int push(ray_buf *b, const cdl_photon_ray *r, uint32_t path)
@@ -191,7 +192,7 @@ static void trace_path(const trace_ctx *cx, uint64_t i, uint32_t off, cdl_vertex
     cdl_sampler_start(&smp, cx->kind, cx->seed, i, cx->pass);
     cdl_vs_clear(vs);
     cdl_escape esc;
-    uint32_t nv = cdl_trace_light_subpath_esc(cx->s, cx->walk, &smp, vs, &b->rays, &esc);
+    uint32_t nv = cdl_trace_light_subpath_esc(cx->s, cx->walk, &smp, vs, &b->rays, &esc, cx->caustic_only);
     if (nv < 1)
         return;
     path_density(cx->s, vs, nv, cx->d2c, pt);
@@ -287,7 +288,7 @@ int cdl_pray_pilot(const cdl_scene *s, const cdl_walk *walk, cdl_sampler_kind ki
 {
     if (check_lights(s, err))
         return err->code;
-    trace_ctx cx = {s, walk, NULL, S, d2_clamp, kind, seed, PILOT_PASS, {0}};
+    trace_ctx cx = {s, walk, NULL, S, d2_clamp, kind, seed, PILOT_PASS, {0}, 0};
     uint32_t nchunks = (n_paths + CHUNK - 1) / CHUNK;
     ray_buf *bufs = calloc(nchunks ? nchunks : 1, sizeof *bufs);
     if (!bufs || run_batch(&cx, 0, n_paths, bufs)) {
@@ -339,7 +340,7 @@ int cdl_pray_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_pray_para
     set->traced = set->rays = 0;
     if (check_lights(s, err))
         return err->code;
-    trace_ctx cx = {s, walk, pp, pp->S, pp->d2_clamp, kind, seed, pass, {0}};
+    trace_ctx cx = {s, walk, pp, pp->S, pp->d2_clamp, kind, seed, pass, {0}, 0};
     int open[CDL_PRAY_CATS], nopen = 0;
     for (int c = 0; c < CDL_PRAY_CATS; c++) {
         open[c] = pp->target[c] > 0;
@@ -363,6 +364,12 @@ int cdl_pray_trace(const cdl_scene *s, const cdl_walk *walk, const cdl_pray_para
         uint64_t nb = batch < MAX_BATCH ? batch : MAX_BATCH;
         if (next + nb > pp->max_paths)
             nb = pp->max_paths - next;
+        /* a budget full before this batch takes none of its rays (below):
+         * with the indirect one full, a ray past a path's first diffuse
+         * vertex (indirect) would be thrown away, so the paths end there
+         * (the caustic budget is typically the last, filling on a small
+         * fraction of several times the paths the others need) */
+        cx.caustic_only = !open[CDL_PRAY_INDIRECT];
         if (run_batch(&cx, next, nb, bufs)) {
             rc = cdl_error_set(err, CDL_ERR_SYSTEM, "photon rays", 0, "out of memory");
             break;

@@ -58,10 +58,11 @@ static uint32_t push(cdl_vertex_store *vs)
 }
 
 /* The random walk after the start vertex `prev`: ray (o, d) carries beta
- * with solid-angle density pdf_dir. */
+ * with solid-angle density pdf_dir; stop: it ends at the first vertex
+ * whose scattering was not specular. */
 static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp, int adjoint,
                         uint32_t prev, cdl_vec3 o, cdl_vec3 d, cdl_vec3 beta, float pdf_dir,
-                        cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc)
+                        cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc, int stop)
 {
     for (int depth = 1;; depth++) {
         cdl_hit h;
@@ -142,6 +143,8 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
                                                   (vs->flags[prev] & (CDL_V_CAMERA | CDL_V_DELTA_LIGHT))
                                                       ? cdl_v3(0.0f, 0.0f, 0.0f)
                                                       : vs->ng[prev]);
+        if (stop && !sc.delta)
+            return;
         if (depth >= walk->rr_depth) {
             float q = cdl_minf(1.0f, cdl_max3(w));
             if (cdl_sampler_cheap(smp) >= q)
@@ -161,11 +164,11 @@ static void random_walk(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *s
 uint32_t cdl_trace_light_subpath(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
                                  cdl_vertex_store *vs, uint64_t *rays)
 {
-    return cdl_trace_light_subpath_esc(s, walk, smp, vs, rays, NULL);
+    return cdl_trace_light_subpath_esc(s, walk, smp, vs, rays, NULL, 0);
 }
 
 uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
-                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc)
+                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc, int first_diffuse)
 {
     uint32_t start = vs->n;
     if (esc)
@@ -203,7 +206,7 @@ uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, c
     float cos = cdl_is_black(e.n) ? 1.0f : fabsf(cdl_dot(e.n, e.d));
     cdl_vec3 beta = cdl_scale(e.Le, cos / (pmf * e.pdf_pos * e.pdf_dir));
     cdl_vec3 o = cdl_is_black(e.n) ? e.p : cdl_offset(s, e.p, e.n, e.d);
-    random_walk(s, walk, smp, 1, i, o, e.d, beta, e.pdf_dir, vs, rays, esc);
+    random_walk(s, walk, smp, 1, i, o, e.d, beta, e.pdf_dir, vs, rays, esc, first_diffuse);
     return vs->n - start;
 }
 
@@ -224,6 +227,6 @@ uint32_t cdl_trace_eye_subpath(const cdl_scene *s, const cdl_camera *cam, float 
     vs->parent[i] = -1;
     vs->depth[i] = 0;
     vs->flags[i] = CDL_V_CAMERA;
-    random_walk(s, walk, smp, 0, i, cam->eye, d, cdl_v3(1.0f, 1.0f, 1.0f), pdf_dir, vs, rays, NULL);
+    random_walk(s, walk, smp, 0, i, cam->eye, d, cdl_v3(1.0f, 1.0f, 1.0f), pdf_dir, vs, rays, NULL, 0);
     return vs->n - start;
 }

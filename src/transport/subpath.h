@@ -30,9 +30,11 @@ typedef struct cdl_escape {
     float pdf_dir;    /* solid-angle density it was sampled with (0: specular) */
 } cdl_escape;
 
-/* The same, telling in esc whether the path ended by leaving the scene. */
+/* The same, telling in esc whether the path ended by leaving the scene;
+ * with first_diffuse it ends at its first vertex that scattered
+ * non-specularly (the vertices up to there are the whole path's). */
 uint32_t cdl_trace_light_subpath_esc(const cdl_scene *s, const cdl_walk *walk, cdl_sampler *smp,
-                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc);
+                                     cdl_vertex_store *vs, uint64_t *rays, cdl_escape *esc, int first_diffuse);
 
 /* Appends an eye subpath through raster point (px, py): x_0 at the camera,
  * then x_1, ... Same room needed (one more with walk->env_vertex); returns
