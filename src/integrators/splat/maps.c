@@ -264,8 +264,11 @@ static void splat_bandwidth(ray_ctx *c, uint32_t first, uint32_t m, uint32_t mas
  * another thread's and are left alone. izsum is the cache's
  * (splat_maps_add): iz is read only by the occlusion test and the
  * bandwidth picture. */
-static void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole, uint32_t mask, const float *w,
-                        const float *iz)
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole, uint32_t mask, const float *w,
+                               const float *iz)
 {
     splat_state *s = c->s;
     if (s->occl) {
