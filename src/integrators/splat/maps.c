@@ -200,9 +200,41 @@ typedef struct ray_ctx {
     uint64_t splats, occluded, occl_rays;
 } ray_ctx;
 
+#if defined(__AVX512F__)
+/* The histogram entries of a whole batch's glossy samples (gall: all of
+ * them, glossy: the feasible ones) at once: glossy indices follow tree
+ * order, so theirs are gloss[first of them] on, consecutive, and their RGB
+ * entries one run of 3 popcount(gall) floats in the stratum's image. The
+ * weights are compressed to that run and spread over its channels; the
+ * infeasible samples' entries take 0 (w * flux with the scalar loop's
+ * rounding: one fused multiply-add per entry). */
+static void glossy_run(const splat_state *s, float *mp, uint32_t first, uint32_t gall, uint32_t glossy, const float *w,
+                       cdl_vec3 flux)
+{
+    static const int32_t ix[3][16] = {{0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 5},
+                                      {5, 5, 6, 6, 6, 7, 7, 7, 8, 8, 8, 9, 9, 9, 10, 10},
+                                      {10, 11, 11, 11, 12, 12, 12, 13, 13, 13, 14, 14, 14, 15, 15, 15}};
+    const __m512 fr = _mm512_set1_ps(flux.x), fg = _mm512_set1_ps(flux.y), fb = _mm512_set1_ps(flux.z);
+    /* lane l of chunk t holds channel (16 t + l) % 3 */
+    const __m512 f[3] = {_mm512_mask_mov_ps(_mm512_mask_mov_ps(fr, 0x4924, fb), 0x2492, fg),
+                         _mm512_mask_mov_ps(_mm512_mask_mov_ps(fr, 0x2492, fb), 0x9249, fg),
+                         _mm512_mask_mov_ps(_mm512_mask_mov_ps(fr, 0x9249, fb), 0x4924, fg)};
+    float *m = mp + 3 * (size_t)s->gloss[first + (uint32_t)__builtin_ctz(gall)];
+    __m512 wc = _mm512_maskz_compress_ps((__mmask16)gall, _mm512_maskz_loadu_ps((__mmask16)glossy, w));
+    uint32_t n = 3 * (uint32_t)__builtin_popcount(gall);
+    for (uint32_t t = 0; 16 * t < n; t++) {
+        uint32_t rem = n - 16 * t;
+        __mmask16 k = (__mmask16)(rem >= 16 ? 0xffffu : (1u << rem) - 1u);
+        __m512 v = _mm512_permutexvar_ps(_mm512_loadu_si512(ix[t]), wc);
+        _mm512_mask_storeu_ps(m + 16 * t, k, _mm512_fmadd_ps(v, f[t], _mm512_maskz_loadu_ps(k, m + 16 * t)));
+    }
+}
+#endif
+
 /* The feasible glossy samples of a batch (bit i: sample first + i): the
- * ray's light in their maps. */
-static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const float *w)
+ * ray's light in their maps; gall: all its glossy samples if the batch is
+ * whole, else 0. */
+static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, uint32_t gall, const float *w)
 {
     splat_state *s = c->s;
     if (s->opt.splat.mode == CDL_SPLAT_HISTOGRAM) { /* add_glossy's, the stratum's image found once */
@@ -210,6 +242,14 @@ static void splat_glossy(ray_ctx *c, uint32_t first, uint32_t glossy, const floa
             splat_terms_of(&c->t, s, c->t.r);
         float *mp = gmap_at(s, 0, c->t.stratum);
         const cdl_vec3 flux = c->t.r->flux;
+#if defined(__AVX512F__)
+        if (gall && __builtin_popcount(glossy) > 2) {
+            glossy_run(s, mp, first, gall, glossy, w, flux);
+            return;
+        }
+#else
+        (void)gall;
+#endif
         for (; glossy; glossy &= glossy - 1) {
             uint32_t i = (uint32_t)__builtin_ctz(glossy);
             float *m = mp + 3 * (size_t)s->gloss[first + i];
@@ -314,7 +354,7 @@ static inline void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole
     }
 #endif
     if (glossy)
-        splat_glossy(c, first, glossy, w);
+        splat_glossy(c, first, glossy, whole ? (uint32_t)(gb >> (first % 32)) & 0xffffu : 0, w);
     if (s->want_bw)
         splat_bandwidth(c, first, m, mask, w, iz);
 }
