@@ -382,16 +382,26 @@ static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *m
         }
 }
 
+/* n floats at p zeroed by all threads (tens of MiB, first touched here
+ * in a pass's first band). */
+static void zero(float *p, size_t n)
+{
+    const size_t step = (size_t)1 << 16;
+#pragma omp parallel for schedule(static) if (n > 4 * step)
+    for (size_t i = 0; i < n; i += step)
+        memset(p + i, 0, sizeof(float) * (n - i < step ? n - i : step));
+}
+
 void splat_maps_clear(splat_state *s)
 {
     size_t n = (size_t)s->neye + 16;
     for (int c = 0; c < 3; c++)
-        memset(s->E[c], 0, sizeof(float) * n);
-    memset(s->izsum, 0, sizeof(float) * n);
-    memset(s->nsum, 0, sizeof(float) * n);
-    memset(s->gmap, 0, sizeof(float) * 3 * s->K * (size_t)s->nglossy);
+        zero(s->E[c], n);
+    zero(s->izsum, n);
+    zero(s->nsum, n);
+    zero(s->gmap, 3 * s->K * (size_t)s->nglossy);
     if (s->want_bw)
-        memset(s->bw, 0, sizeof(float) * SPLAT_BW * n);
+        zero(s->bw, SPLAT_BW * n);
 }
 
 int splat_maps_splat(splat_state *s)
