@@ -302,7 +302,7 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
     mask_ray mr = {&s->tree, r, m->pw, (const float *const *)m->ax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
                    /* ~10x the rounding of a plane offset at the coordinates' scale */
-                   1e-5f * big, 0, INT32_MIN, x->grid};
+                   1e-5f * big, 0, INT32_MIN, x->grid, 0};
     float hmax = r->h0 + r->dh * r->len;
     /* a mask if the frustum holds more than one plane, a buffer if one
      * of them may hide a feasible sample */
