@@ -320,10 +320,22 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
     _mm512_storeu_si512(key + 8,
                         _mm512_or_si512(_mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(z, 1)), 32),
                                         _mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(idx, 1))));
-    __m512i acc[8];
+    /* two sets of rows, the lanes taken in pairs: half the chain of mins */
+    __m512i acc[8], alt[8];
     for (int r = 0; r < R; r++)
-        acc[r] = _mm512_set1_epi64(-1);
-    for (uint32_t m = live; m; m &= m - 1) {
+        acc[r] = alt[r] = _mm512_set1_epi64(-1);
+    uint32_t m = live;
+    for (; m & (m - 1); m &= m - 1) {
+        int i = __builtin_ctz(m);
+        m &= m - 1;
+        int j = __builtin_ctz(m);
+        const __m512i k = _mm512_set1_epi64((long long)key[i]), l = _mm512_set1_epi64((long long)key[j]);
+        for (int r = 0; r < R; r++) {
+            acc[r] = _mm512_mask_min_epu64(acc[r], (__mmask8)km[r][i], acc[r], k);
+            alt[r] = _mm512_mask_min_epu64(alt[r], (__mmask8)km[r][j], alt[r], l);
+        }
+    }
+    if (m) {
         int i = __builtin_ctz(m);
         const __m512i k = _mm512_set1_epi64((long long)key[i]);
         for (int r = 0; r < R; r++)
@@ -333,7 +345,7 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
     const __mmask8 in = (__mmask8)(g - A0 >= 8 ? 0xffu : (1u << (g - A0)) - 1u);
     for (int r = 0; r <= B1 - B0; r++) {
         uint64_t *c = x->grid + (ptrdiff_t)(B0 + r) * g + A0;
-        _mm512_mask_storeu_epi64(c, in, _mm512_min_epu64(_mm512_maskz_loadu_epi64(in, c), acc[r]));
+        _mm512_mask_storeu_epi64(c, in, _mm512_min_epu64(_mm512_maskz_loadu_epi64(in, c), _mm512_min_epu64(acc[r], alt[r])));
     }
 }
 #endif
