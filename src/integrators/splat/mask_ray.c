@@ -424,10 +424,21 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
 #if defined(__AVX512F__)
     const uint32_t live = small | large;
     if (live && !x->plain) {
-        int A0 = _mm512_mask_reduce_min_epi32((__mmask16)live, _mm512_loadu_si512(box[0]));
-        int A1 = _mm512_mask_reduce_max_epi32((__mmask16)live, _mm512_loadu_si512(box[1]));
-        int B0 = _mm512_mask_reduce_min_epi32((__mmask16)live, _mm512_loadu_si512(box[2]));
-        int B1 = _mm512_mask_reduce_max_epi32((__mmask16)live, _mm512_loadu_si512(box[3]));
+        /* the live boxes' extremes in one reduction: a lane's a0, b0,
+         * 255 - a1 and 255 - b1 (all in [0, g)) as its bytes, their minima */
+        const __m512i ff = _mm512_set1_epi32(255);
+        __m512i pk = _mm512_or_si512(
+            _mm512_or_si512(_mm512_loadu_si512(box[0]), _mm512_slli_epi32(_mm512_loadu_si512(box[2]), 8)),
+            _mm512_or_si512(_mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[1])), 16),
+                            _mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[3])), 24)));
+        pk = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), (__mmask16)live, pk);
+        __m256i h = _mm256_min_epu8(_mm512_castsi512_si256(pk), _mm512_extracti64x4_epi64(pk, 1));
+        __m128i q = _mm_min_epu8(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0x4e));
+        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0xb1));
+        const uint32_t e = (uint32_t)_mm_cvtsi128_si32(q);
+        const int A0 = (int)(e & 255u), B0 = (int)(e >> 8 & 255u);
+        const int A1 = 255 - (int)(e >> 16 & 255u), B1 = 255 - (int)(e >> 24);
         if (A1 - A0 < 8 && B1 - B0 < 8) {
             if (B1 - B0 < 2)
                 window8(x, first, live, box, zk, A0, B0, B1, 2);
