@@ -413,7 +413,7 @@ int splat_maps_splat(splat_state *s)
     /* with visibility masks, a batch of rays at a time: one traversal per
      * ray builds its mask and keeps the splats it lets through, which the
      * parts then replay */
-    uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (s->rays.n ? s->rays.n : 1);
+    uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {

@@ -18,22 +18,26 @@
  * only needs no mask.
  *
  * Cost (issue 29): one traversal per ray, as the report rasterizes
- * "during the ray traversal": a batch of SPLAT_MASK_BATCH rays at a time,
+ * "during the ray traversal": a batch of rays at a time (splat_mask_batch),
  * in parallel over the rays, each ray's traversal yields the frustum's
  * samples and the feasible ones (cdl_skd_splat_visit_both: the same
  * weights bit for bit as the traversal without masks). Most rays need no
  * buffer (mask_ray.c: one plane in the frustum, or no sample whose plane
  * has a feasible one behind it); the others rasterize and filter their
- * feasible samples right away. The survivors (weights and 1 / z, packed
- * to their lanes) are kept per ray, split by tree part; the batch then
+ * feasible samples right away. The survivors (weights, and 1 / z if the
+ * occlusion test or the bandwidth AOV reads it, packed to their lanes)
+ * are kept per ray, split by tree part; the batch then
  * splats part by part as without masks, each part replaying its rays'
  * kept splats in ray order, so every sample sums its splats in the same
  * order and the image is the one two traversals gave. A cell holds its
  * front sample as one 64-bit key, distance bits over the sample's index
  * (z >= 0: the float's bits order as the float), so z-min with the
  * index's tie-break is one unsigned min. On the Cornell box (global
- * light, 250000 photon rays) the kept splats of 4096 rays take about 70
- * MiB, the buffers 8 KiB per thread. */
+ * light, 250000 photon rays) the kept splats of 8192 rays take about 70
+ * MiB (of 4096 with 1 / z), the buffers 8 KiB per thread; a batch ends
+ * in two barriers, where a thread another process holds up keeps the
+ * other waiting (half as many batches: 10 % less time on a loaded
+ * machine). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,7 +50,7 @@
 #include "integrators/splat/mask.h"
 #include "integrators/splat/mask_ray.h"
 
-/* A kept batch: its lanes' w then 1 / z from val[off], packed. */
+/* A kept batch: its lanes' w then (if wiz) 1 / z from val[off], packed. */
 typedef struct mask_rec {
     uint32_t first, keep, off;
 } mask_rec;
@@ -73,6 +77,7 @@ typedef struct mask_worker {
 
 struct splat_mask {
     uint32_t first;     /* the batch's first ray */
+    int wiz;            /* 1 / z kept too (the occlusion test or the bandwidth AOV reads it) */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
     float *pw;          /* per eye sample (tree order) its footprint, contiguous for the leaf loops */
     float *ax[6];       /* and the semi-axes of the surface patch it stands for (see prepare) */
@@ -86,6 +91,11 @@ struct splat_mask {
     mask_pentry *plist;
     uint32_t cappl;
 };
+
+uint32_t splat_mask_batch(const splat_state *s)
+{
+    return s->occl || s->want_bw ? SPLAT_MASK_BATCH / 2 : SPLAT_MASK_BATCH;
+}
 
 int splat_mask_alloc(splat_state *s, cdl_error *err)
 {
@@ -236,40 +246,28 @@ static void collect(void *ctx, uint32_t first, uint32_t m, uint32_t any, const f
     }
 }
 
-/* Packs the kept lanes' w and 1 / z at val (2 popcount(keep) floats). */
-static inline void pack(float *val, uint32_t keep, const float *w, const float *iz)
+/* Packs the kept lanes of x at val (popcount(keep) floats). */
+static inline void pack(float *val, uint32_t keep, const float *x)
 {
 #if defined(__AVX512F__)
-    const __mmask16 k = (__mmask16)keep;
     const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
-    const int n = __builtin_popcount(keep);
-    _mm512_mask_storeu_ps(val, lo, _mm512_maskz_compress_ps(k, _mm512_loadu_ps(w)));
-    _mm512_mask_storeu_ps(val + n, lo, _mm512_maskz_compress_ps(k, _mm512_loadu_ps(iz)));
+    _mm512_mask_storeu_ps(val, lo, _mm512_maskz_compress_ps((__mmask16)keep, _mm512_loadu_ps(x)));
 #else
-    uint32_t n = (uint32_t)__builtin_popcount(keep), j = 0;
-    for (; keep; keep &= keep - 1, j++) {
-        int i = __builtin_ctz(keep);
-        val[j] = w[i];
-        val[n + j] = iz[i];
-    }
+    for (uint32_t j = 0; keep; keep &= keep - 1, j++)
+        val[j] = x[__builtin_ctz(keep)];
 #endif
 }
 
 /* The inverse: 16 lanes, 0 where not kept. */
-static inline void unpack(const float *val, uint32_t keep, float *w, float *iz)
+static inline void unpack(const float *val, uint32_t keep, float *x)
 {
 #if defined(__AVX512F__)
-    const __mmask16 k = (__mmask16)keep;
     const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
-    const int n = __builtin_popcount(keep);
-    _mm512_storeu_ps(w, _mm512_maskz_expand_ps(k, _mm512_maskz_loadu_ps(lo, val)));
-    _mm512_storeu_ps(iz, _mm512_maskz_expand_ps(k, _mm512_maskz_loadu_ps(lo, val + n)));
+    _mm512_storeu_ps(x, _mm512_maskz_expand_ps((__mmask16)keep, _mm512_maskz_loadu_ps(lo, val)));
 #else
-    uint32_t n = (uint32_t)__builtin_popcount(keep), j = 0;
-    for (int i = 0; i < 16; i++) {
+    for (uint32_t i = 0, j = 0; i < 16; i++) {
         int in = (int)(keep >> i & 1u);
-        w[i] = in ? val[j] : 0.0f;
-        iz[i] = in ? val[n + j] : 0.0f;
+        x[i] = in ? val[j] : 0.0f;
         j += (uint32_t)in;
     }
 #endif
@@ -302,7 +300,7 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
     mask_ray mr = {&s->tree, r, m->pw, (const float *const *)m->ax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
                    /* ~10x the rounding of a plane offset at the coordinates' scale */
-                   1e-5f * big, 0, INT32_MIN, x->grid};
+                   1e-5f * big, 0, INT32_MIN, x->grid, 0};
     float hmax = r->h0 + r->dh * r->len;
     /* a mask if the frustum holds more than one plane, a buffer if one
      * of them may hide a feasible sample */
@@ -332,7 +330,7 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
             continue;
         while (p + 1 < np && fb->first >= parts[p].hi)
             p++;
-        uint32_t nv = 2 * (uint32_t)__builtin_popcount(keep);
+        uint32_t nk = (uint32_t)__builtin_popcount(keep), nv = m->wiz ? 2 * nk : nk;
         if (cdl_grow((void **)&x->rec, &x->caprec, x->nrec + 1, sizeof *x->rec) ||
             cdl_grow((void **)&x->val, &x->capval, x->nval + nv, sizeof *x->val)) {
             x->oom = 1;
@@ -348,7 +346,9 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
             m->rnseg[k]++;
         }
         x->rec[x->nrec++] = (mask_rec){fb->first, keep, x->nval};
-        pack(x->val + x->nval, keep, fb->w, fb->iz);
+        pack(x->val + x->nval, keep, fb->w);
+        if (m->wiz)
+            pack(x->val + x->nval + nk, keep, fb->iz);
         x->nval += nv;
         x->seg[cur].n++;
     }
@@ -418,6 +418,7 @@ int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
 {
     splat_mask *m = s->mask;
     m->first = first;
+    m->wiz = splat_mask_batch(s) < SPLAT_MASK_BATCH;
     if (workers(m))
         return CDL_ERR_SYSTEM;
     build_count bc = {0, 0, 0, 0, 0, 0, 0};
@@ -454,13 +455,15 @@ void splat_mask_replay(const splat_state *s, uint32_t part, splat_mask_fn fn, vo
     const splat_mask *m = s->mask;
     if (part >= m->npart)
         return;
+    float w[16], iz[16] = {0.0f}; /* iz stays 0 where nothing reads it */
     for (uint32_t e = m->pstart[part]; e < m->pstart[part + 1]; e++) {
         const mask_pentry *pe = &m->plist[e];
         const mask_worker *x = &m->w[pe->w];
         for (uint32_t j = pe->rec0; j < pe->rec0 + pe->n; j++) {
             const mask_rec *rc = &x->rec[j];
-            float w[16], iz[16];
-            unpack(x->val + rc->off, rc->keep, w, iz);
+            unpack(x->val + rc->off, rc->keep, w);
+            if (m->wiz)
+                unpack(x->val + rc->off + (uint32_t)__builtin_popcount(rc->keep), rc->keep, iz);
             fn(ctx, m->first + pe->ray, rc->first, rc->keep, w, iz);
         }
     }

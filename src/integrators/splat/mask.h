@@ -9,7 +9,10 @@
  * CDL_ERR_SYSTEM); replay hands part `part` its kept splats ray by ray in
  * order, as batches of 16 lanes like a traversal's (cdl_skd_visit), the
  * ray's index first. */
-#define SPLAT_MASK_BATCH 4096u
+#define SPLAT_MASK_BATCH 8192u
+/* Rays a batch takes: SPLAT_MASK_BATCH, half of it where the kept splats
+ * hold 1 / z too (about the same memory: 70 MiB on the Cornell box). */
+uint32_t splat_mask_batch(const splat_state *s);
 typedef struct splat_mask splat_mask;
 int splat_mask_alloc(splat_state *s, cdl_error *err);
 void splat_mask_free(splat_state *s);

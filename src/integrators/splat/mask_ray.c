@@ -12,6 +12,7 @@
  * rasterized. The loops run 16 lanes at a time (AVX-512 where there is,
  * else plain loops the compiler vectorizes). */
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -146,6 +147,18 @@ static inline void cells16(const mask_ray *x, const mask_feas *fb, int *cell, in
 void splat_mask_reach(mask_ray *x, const mask_feas *f, uint32_t nf)
 {
     int32_t reach = INT32_MIN;
+#if defined(__AVX512F__)
+    /* the same division and subtraction 16 lanes at a time */
+    __m512i rv = _mm512_set1_epi32(INT32_MIN);
+    for (uint32_t j = 0; j < nf; j++) {
+        const __m512 iz = _mm512_loadu_ps(f[j].iz);
+        const __m512 z = _mm512_maskz_div_ps(_mm512_cmp_ps_mask(iz, _mm512_setzero_ps(), _CMP_GT_OQ),
+                                             _mm512_set1_ps(1.0f), iz);
+        const __m512 b = _mm512_sub_ps(z, _mm512_loadu_ps(x->pw + f[j].first));
+        rv = _mm512_mask_max_epi32(rv, (__mmask16)f[j].mask, rv, _mm512_castps_si512(b));
+    }
+    reach = _mm512_reduce_max_epi32(rv);
+#else
     for (uint32_t j = 0; j < nf; j++) {
         const float *iz = f[j].iz, *pw = x->pw + f[j].first;
         for (uint32_t mask = f[j].mask; mask; mask &= mask - 1) {
@@ -155,6 +168,7 @@ void splat_mask_reach(mask_ray *x, const mask_feas *f, uint32_t nf)
             reach = b > reach ? b : reach;
         }
     }
+#endif
     x->reach = reach;
 }
 
@@ -274,6 +288,68 @@ int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, cons
  * from the stores of the lanes before, which hit the same cells). */
 static inline void cell_min(uint64_t *c, uint64_t key) { *c = key < *c ? key : *c; }
 
+#if defined(__AVX512F__)
+/* The batch's boxes when they lie within 8 columns from A0 and R rows
+ * from B0 (R = 2, 4 or 8, a constant: the loops unroll): the window's
+ * rows z-min in registers, a row's 8 cells one vector, each sample a
+ * masked min per row (its columns in the rows it covers), then one
+ * update of the grid per row. Scalar updates of the grid each load what
+ * the one before stored: a chain of store forwards. */
+static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, const int (*box)[16], const uint32_t *zk,
+                           int A0, int B0, int B1, const int R)
+{
+    const __m512i one = _mm512_set1_epi32(1), two = _mm512_set1_epi32(2);
+    const __m512i a0 = _mm512_loadu_si512(box[0]), a1 = _mm512_loadu_si512(box[1]);
+    const __m512i b0 = _mm512_loadu_si512(box[2]), b1 = _mm512_loadu_si512(box[3]);
+    /* per lane its columns and rows in the window, as bits */
+    const __m512i cols = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(a1, a0)), one),
+                                           _mm512_sub_epi32(a0, _mm512_set1_epi32(A0)));
+    const __m512i rows = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(b1, b0)), one),
+                                           _mm512_sub_epi32(b0, _mm512_set1_epi32(B0)));
+    uint8_t km[8][16];
+    for (int r = 0; r < R; r++) {
+        __mmask16 in = _mm512_test_epi32_mask(rows, _mm512_set1_epi32(1 << r));
+        _mm_storeu_si128((__m128i *)km[r], _mm512_cvtepi32_epi8(_mm512_maskz_mov_epi32(in, cols)));
+    }
+    uint64_t key[16];
+    const __m512i z = _mm512_loadu_si512(zk);
+    const __m512i idx = _mm512_add_epi32(_mm512_set1_epi32((int)first),
+                                         _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+    _mm512_storeu_si512(key, _mm512_or_si512(_mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_castsi512_si256(z)), 32),
+                                             _mm512_cvtepu32_epi64(_mm512_castsi512_si256(idx))));
+    _mm512_storeu_si512(key + 8,
+                        _mm512_or_si512(_mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(z, 1)), 32),
+                                        _mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(idx, 1))));
+    /* two sets of rows, the lanes taken in pairs: half the chain of mins */
+    __m512i acc[8], alt[8];
+    for (int r = 0; r < R; r++)
+        acc[r] = alt[r] = _mm512_set1_epi64(-1);
+    uint32_t m = live;
+    for (; m & (m - 1); m &= m - 1) {
+        int i = __builtin_ctz(m);
+        m &= m - 1;
+        int j = __builtin_ctz(m);
+        const __m512i k = _mm512_set1_epi64((long long)key[i]), l = _mm512_set1_epi64((long long)key[j]);
+        for (int r = 0; r < R; r++) {
+            acc[r] = _mm512_mask_min_epu64(acc[r], (__mmask8)km[r][i], acc[r], k);
+            alt[r] = _mm512_mask_min_epu64(alt[r], (__mmask8)km[r][j], alt[r], l);
+        }
+    }
+    if (m) {
+        int i = __builtin_ctz(m);
+        const __m512i k = _mm512_set1_epi64((long long)key[i]);
+        for (int r = 0; r < R; r++)
+            acc[r] = _mm512_mask_min_epu64(acc[r], (__mmask8)km[r][i], acc[r], k);
+    }
+    const int g = x->g;
+    const __mmask8 in = (__mmask8)(g - A0 >= 8 ? 0xffu : (1u << (g - A0)) - 1u);
+    for (int r = 0; r <= B1 - B0; r++) {
+        uint64_t *c = x->grid + (ptrdiff_t)(B0 + r) * g + A0;
+        _mm512_mask_storeu_epi64(c, in, _mm512_min_epu64(_mm512_maskz_loadu_epi64(in, c), _mm512_min_epu64(acc[r], alt[r])));
+    }
+}
+#endif
+
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
 {
     const cdl_skd *t = x->t;
@@ -345,6 +421,35 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
         large |= (uint32_t)(kind[i] == 2) << i;
     }
     small &= near, large &= near;
+#if defined(__AVX512F__)
+    const uint32_t live = small | large;
+    if (live && !x->plain) {
+        /* the live boxes' extremes in one reduction: a lane's a0, b0,
+         * 255 - a1 and 255 - b1 (all in [0, g)) as its bytes, their minima */
+        const __m512i ff = _mm512_set1_epi32(255);
+        __m512i pk = _mm512_or_si512(
+            _mm512_or_si512(_mm512_loadu_si512(box[0]), _mm512_slli_epi32(_mm512_loadu_si512(box[2]), 8)),
+            _mm512_or_si512(_mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[1])), 16),
+                            _mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[3])), 24)));
+        pk = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), (__mmask16)live, pk);
+        __m256i h = _mm256_min_epu8(_mm512_castsi512_si256(pk), _mm512_extracti64x4_epi64(pk, 1));
+        __m128i q = _mm_min_epu8(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0x4e));
+        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0xb1));
+        const uint32_t e = (uint32_t)_mm_cvtsi128_si32(q);
+        const int A0 = (int)(e & 255u), B0 = (int)(e >> 8 & 255u);
+        const int A1 = 255 - (int)(e >> 16 & 255u), B1 = 255 - (int)(e >> 24);
+        if (A1 - A0 < 8 && B1 - B0 < 8) {
+            if (B1 - B0 < 2)
+                window8(x, first, live, box, zk, A0, B0, B1, 2);
+            else if (B1 - B0 < 4)
+                window8(x, first, live, box, zk, A0, B0, B1, 4);
+            else
+                window8(x, first, live, box, zk, A0, B0, B1, 8);
+            return (uint32_t)__builtin_popcount(live);
+        }
+    }
+#endif
     for (uint32_t m = small; m; m &= m - 1) {
         int i = __builtin_ctz(m);
         uint64_t key = (uint64_t)zk[i] << 32 | (first + (uint32_t)i);

@@ -29,6 +29,7 @@ typedef struct mask_ray {
     int32_t reach;               /* the largest z - pw of a feasible sample, as bits: no sample
                                   * as far along the ray can hide one */
     uint64_t *grid;              /* g x g cells: distance bits << 32 | sample; UINT64_MAX empty */
+    int plain;                   /* rasterize one cell at a time (tests: the windows' reference) */
 } mask_ray;
 
 /* Whether the held samples that can hide anything lie on one plane. */
