@@ -2,6 +2,7 @@
  * are in splatkd_query.c. */
 #include "spatial/splatkd.h"
 
+#include "core/grow.h"
 #include "core/octahedral.h"
 #include "spatial/splatkd_node.h"
 
@@ -62,15 +63,9 @@ static uint32_t push(sub *o, uint32_t a, uint32_t w)
 
 static void add_part(sub *o, uint32_t node, uint32_t lo, uint32_t hi, const float *mn, const float *mx)
 {
-    if (o->nparts == o->pcap) {
-        uint32_t cap = o->pcap ? 2 * o->pcap : 8;
-        cdl_skd_part *np = realloc(o->parts, sizeof *np * cap);
-        if (!np) {
-            o->fail = 1;
-            return;
-        }
-        o->parts = np;
-        o->pcap = cap;
+    if (cdl_grow((void **)&o->parts, &o->pcap, o->nparts + 1, sizeof *o->parts)) {
+        o->fail = 1;
+        return;
     }
     cdl_skd_part *p = &o->parts[o->nparts++];
     p->node = node;
