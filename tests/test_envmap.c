@@ -400,39 +400,43 @@ static void sphere_under_constant(const char *integ, int equal_area)
 /* A pbrt-v3 scene's infinite light with a mapname: the map is read,
  * scaled by L and turned by the CTM (Rotate -90 1 0 0: the map's +z is the
  * world's +y), and a missing map is an error naming it. */
-static void pbrt_map(void)
+static void pbrt_map(const char *integ)
 {
+    /* named per integrator: the suite runs its instances in parallel */
+    char exr[64], pbrt[64];
+    snprintf(exr, sizeof exr, "envsky-%s.exr", integ);
+    snprintf(pbrt, sizeof pbrt, "envsky-%s.pbrt", integ);
     cdl_image img;
     cdl_error err;
     die_on(cdl_image_alloc(&img, 8, 4, &err), &err);
     for (int i = 0; i < 8 * 4; i++)
         for (int c = 0; c < 3; c++)
             img.rgb[3 * i + c] = i < 16 ? 2.0f : 0.5f;
-    die_on(cdl_image_write("envsky.exr", &img, NULL, 0, 0.0f, &err), &err);
+    die_on(cdl_image_write(exr, &img, NULL, 0, 0.0f, &err), &err);
     cdl_image_free(&img);
     const char *text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n"
                        "AttributeBegin\nRotate -90 1 0 0\n"
                        "LightSource \"infinite\" \"string mapname\" \"%s\" \"rgb L\" [3 3 3]\nAttributeEnd\n"
                        "Shape \"sphere\" \"float radius\" 1\n";
     for (int missing = 0; missing < 3; missing++) {
-        FILE *f = fopen("envsky.pbrt", "w");
-        fprintf(f, text, missing ? "nosuch.exr" : "envsky.exr");
+        FILE *f = fopen(pbrt, "w");
+        fprintf(f, text, missing ? "nosuch.exr" : exr);
         fclose(f);
         if (missing == 2) { /* pbrt-v4's filename: equal-area, so square */
-            f = fopen("envsky.pbrt", "w");
-            fprintf(f, "WorldBegin\nLightSource \"infinite\" \"string filename\" \"envsky.exr\"\n"
-                       "Shape \"sphere\" \"float radius\" 1\n");
+            f = fopen(pbrt, "w");
+            fprintf(f, "WorldBegin\nLightSource \"infinite\" \"string filename\" \"%s\"\n"
+                       "Shape \"sphere\" \"float radius\" 1\n", exr);
             fclose(f);
         }
         cdl_scene s;
         cdl_scene_settings set;
-        int rc = cdl_scene_init(&s, "envsky.pbrt", &err);
+        int rc = cdl_scene_init(&s, pbrt, &err);
         if (!rc)
-            rc = cdl_scene_load(&s, "envsky.pbrt", &set, &err);
+            rc = cdl_scene_load(&s, pbrt, &set, &err);
         if (!rc)
             rc = cdl_scene_commit(&s, &err);
         if (missing == 2) {
-            CHECK(rc && strstr(err.file, "envsky.exr") && strstr(err.msg, "square"),
+            CHECK(rc && strstr(err.file, exr) && strstr(err.msg, "square"),
                   "pbrt-v4: an 8x4 equal-area map is an error: %s: %s", err.file, err.msg);
         } else if (missing) {
             CHECK(rc && strstr(err.file, "nosuch.exr"), "pbrt: a missing map is an error naming it (%s)", err.file);
@@ -460,7 +464,7 @@ int main(int argc, char **argv)
     sampling(CDL_ENVMAP_EQUAL_AREA);
     sampling(CDL_ENVMAP_MITSUBA);
     mitsuba_layout();
-    pbrt_map();
+    pbrt_map(integ);
     plane_under_map(integ, 1, CDL_ENVMAP_EQUIRECT);
     plane_under_map(integ, 0, CDL_ENVMAP_EQUIRECT);
     plane_under_map(integ, 0, CDL_ENVMAP_MITSUBA);
