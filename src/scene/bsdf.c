@@ -14,6 +14,22 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
 {
     b->type = m->type;
     b->kd = kd;
+    b->opacity = m->masked ? cdl_minf(1.0f, cdl_maxf(0.0f, m->opacity)) : 1.0f;
+    b->ng = ng;
+    /* Shading normal on the geometric normal's side: interpolated normals
+     * of a mesh with flipped winding must not turn the frame inside out. */
+    if (cdl_dot(ns, ng) < 0.0f)
+        ns = cdl_neg(ns);
+    b->frame = cdl_frame_from(ns);
+    b->nb = ns;
+    b->perturbed = 0;
+    b->one_sided = m->one_sided && is_opaque(b);
+    b->p_spec = 0.0f;
+    /* Lambert reads none of the other constants: not copying them at every
+     * vertex was a tenth of path's shading time (issue 29). Textured
+     * roughness (cdl_scene_bsdf_maps) may still set ax, ay. */
+    if (b->type == CDL_MAT_DIFFUSE)
+        return;
     b->ks = m->ks;
     b->kt = m->kt;
     b->ns = m->ns;
@@ -28,20 +44,9 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->sigma = m->sigma;
     b->on_full = m->on_full;
     b->coat_t = m->coat_t;
-    b->opacity = m->masked ? cdl_minf(1.0f, cdl_maxf(0.0f, m->opacity)) : 1.0f;
     /* below ~1e-4 the GGX lobe underflows in float */
     b->ax = cdl_maxf(m->alpha_x, 1e-4f);
     b->ay = cdl_maxf(m->alpha_y, 1e-4f);
-    b->ng = ng;
-    /* Shading normal on the geometric normal's side: interpolated normals
-     * of a mesh with flipped winding must not turn the frame inside out. */
-    if (cdl_dot(ns, ng) < 0.0f)
-        ns = cdl_neg(ns);
-    b->frame = cdl_frame_from(ns);
-    b->nb = ns;
-    b->perturbed = 0;
-    b->one_sided = m->one_sided && is_opaque(b);
-    b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PRINCIPLED) /* constants; cdl_scene_bsdf adds textures */
         cdl_principled_at_init(&b->pr, &m->pr, NULL, 0.0f, 0.0f);
     if (b->type == CDL_MAT_PHONG) {
