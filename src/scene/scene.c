@@ -612,8 +612,8 @@ void cdl_sphere_surface(const float *q, int inward, cdl_vec3 ng, cdl_surface *sf
     sf->geom = CDL_GEOM_SPHERES;
 }
 
-void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1, float b2,
-                          cdl_surface *sf)
+static inline void triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1,
+                                    float b2, cdl_surface *sf)
 {
     float b0 = 1.0f - b1 - b2;
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
@@ -646,8 +646,16 @@ void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl
     sf->geom = CDL_GEOM_TRIANGLES;
 }
 
+void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1, float b2,
+                          cdl_surface *sf)
+{
+    triangle_surface(s, t, fl, face_n, b1, b2, sf);
+}
+
 /* The surface at a hit, world space, with the material's maps applied
- * for the viewing direction (one shading frame for every method). */
+ * for the viewing direction (one shading frame for every method). The
+ * common case, a plain material on the scene's triangles, makes no call:
+ * path does this at every vertex (issue 29). */
 void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
     if (h->inst != CDL_NO_INST) {
@@ -657,17 +665,28 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
         sf->mat = s->sph_mat[h->prim];
         sf->light = s->sph_light[h->prim];
     } else {
-        cdl_triangle_surface(s, s->idx + 3 * (size_t)h->prim, s->tri_flags[h->prim], s->face_n[h->prim], h->b1,
-                             h->b2, sf);
+        triangle_surface(s, s->idx + 3 * (size_t)h->prim, s->tri_flags[h->prim], s->face_n[h->prim], h->b1, h->b2,
+                         sf);
         sf->mat = s->tri_mat[h->prim];
         sf->light = s->tri_light[h->prim];
     }
     sf->prim = h->prim;
-    cdl_surface_material(s, h, sf);
-    cdl_surface_shade(s, sf, cdl_neg(h->d));
+    const cdl_material *m = &s->mats[sf->mat];
+    if (m->type == CDL_MAT_BLEND || m->hit_kd) {
+        cdl_surface_material(s, h, sf);
+        m = &s->mats[sf->mat];
+    } else {
+        sf->kdh = cdl_v3(1.0f, 1.0f, 1.0f); /* as cdl_surface_material leaves it */
+    }
+    if (cdl_mat_uses_tangent(&m->maps, m->alpha_x, m->alpha_y)) {
+        cdl_surface_shade(s, sf, cdl_neg(h->d));
+    } else { /* as cdl_surface_shade leaves it */
+        sf->nb = sf->ns;
+        sf->ts = cdl_v3(0.0f, 0.0f, 0.0f);
+    }
 }
 
-void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
+void cdl_scene_bsdf_any(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
 {
     const cdl_material *m = &s->mats[sf->mat];
     cdl_vec3 kd = m->kd;

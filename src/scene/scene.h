@@ -279,7 +279,19 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
  * (sf->ns, nb and ts), for a viewer in direction wo (scene/shading.c). */
 void cdl_surface_shade(const cdl_scene *s, cdl_surface *sf, cdl_vec3 wo);
 /* Texture lookup folded in; the frame is sf's ns and ts. */
-void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
+void cdl_scene_bsdf_any(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
+/* The same, a plain Lambertian material (no texture, map or tangent
+ * frame) built inline: every vertex of path builds one. */
+static inline void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
+{
+    const cdl_material *m = &s->mats[sf->mat];
+    if (m->type != CDL_MAT_DIFFUSE || m->hit_kd || m->kd_tex >= 0 || m->maps.on || m->opacity_tex >= 0 ||
+        !cdl_is_black(sf->ts)) {
+        cdl_scene_bsdf_any(s, sf, b);
+        return;
+    }
+    cdl_bsdf_init_common(b, m, m->kd, sf->ns, sf->ng);
+}
 
 /* Origin for a ray leaving p in direction d: pushed off the surface along
  * ng to the side d goes to, so the ray cannot hit the surface it left. */
