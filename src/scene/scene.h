@@ -285,7 +285,7 @@ void cdl_scene_bsdf_any(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
 static inline void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
 {
     const cdl_material *m = &s->mats[sf->mat];
-    if (m->type != CDL_MAT_DIFFUSE || m->hit_kd || m->kd_tex >= 0 || m->maps.on || m->opacity_tex >= 0 ||
+    if (m->type != CDL_MAT_DIFFUSE || m->hit_kd || m->kd_tex >= 0 || m->maps.on || (m->masked && m->opacity_tex >= 0) ||
         !cdl_is_black(sf->ts)) {
         cdl_scene_bsdf_any(s, sf, b);
         return;
