@@ -94,15 +94,16 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
         /* the vertex's numbers drawn together, in the order they are used:
          * their hash chains are independent and overlap */
         float u[7];
-        int nee = !cdl_bsdf_is_delta(&b);
-        if (nee) {
+        if (!cdl_bsdf_is_delta(&b)) {
             cdl_sampler_2d(smp, &u[0], &u[1]);
             cdl_sampler_2d(smp, &u[2], &u[3]);
-        }
-        u[4] = cdl_sampler_1d(smp);
-        cdl_sampler_2d(smp, &u[5], &u[6]);
-        if (nee)
+            u[4] = cdl_sampler_1d(smp);
+            cdl_sampler_2d(smp, &u[5], &u[6]);
             L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, u, rays)));
+        } else {
+            u[4] = cdl_sampler_1d(smp);
+            cdl_sampler_2d(smp, &u[5], &u[6]);
+        }
         cdl_scatter bs;
         if (!cdl_bsdf_sample(&b, wo, u[4], u[5], u[6], 0, &bs))
             break;

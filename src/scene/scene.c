@@ -619,11 +619,10 @@ static inline void triangle_surface(const cdl_scene *s, const uint32_t *t, uint8
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
                 *p2 = s->pos + 3 * (size_t)t[2];
     /* Barycentric position: closer to the surface than o + t d. */
-    sf->p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0],
-                   b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
-                   b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
-    sf->ng = face_n;
-    sf->ns = sf->ng;
+    cdl_vec3 p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0],
+                        b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
+                        b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
+    cdl_vec3 ns = face_n;
     if (fl & CDL_TRI_HAS_N) {
         const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
                     *n2 = s->nrm + 3 * (size_t)t[2];
@@ -632,8 +631,13 @@ static inline void triangle_surface(const cdl_scene *s, const uint32_t *t, uint8
                             b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
         float len = cdl_length(n);
         if (len > 1e-12f && isfinite(len))
-            sf->ns = cdl_scale(n, 1.0f / len);
+            ns = cdl_scale(n, 1.0f / len);
     }
+    /* stored once, from registers: copying sf->ng to sf->ns read back
+     * parts of two stores, a failed store forward on path's chain */
+    sf->p = p;
+    sf->ng = face_n;
+    sf->ns = ns;
     sf->u = sf->v = 0.0f;
     sf->dpdu = sf->dpdv = cdl_v3(0.0f, 0.0f, 0.0f);
     if (fl & CDL_TRI_HAS_UV) {
