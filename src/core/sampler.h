@@ -93,15 +93,32 @@ static inline void cdl_sampler_start(cdl_sampler *s, cdl_sampler_kind kind, uint
         cdl_rng_seed(&s->rng, seed, cdl_mix64(stream) ^ ((uint64_t)index << 40) ^ index);
 }
 
-/* Shuffled index for the current dimension: an Owen scramble of the
- * index bits, so every aligned block of 2^k passes stays a (0,k,2)-net. */
-static inline uint32_t cdl_sampler_next(cdl_sampler *s, uint32_t *s1, uint32_t *s2)
+/* Shuffled index of dimension dim (a function of key, dim and the
+ * reversed pass rindex alone): an Owen scramble of the index bits, so
+ * every aligned block of 2^k passes stays a (0,k,2)-net. */
+static inline uint32_t cdl_sobol_index(uint64_t key, uint32_t rindex, uint32_t dim, uint32_t *s1, uint32_t *s2)
 {
-    uint64_t h = cdl_mix64(s->key + (uint64_t)s->dim * 0x9e3779b97f4a7c15ULL);
-    s->dim++;
+    uint64_t h = cdl_mix64(key + (uint64_t)dim * 0x9e3779b97f4a7c15ULL);
     *s1 = (uint32_t)(h >> 32);
     *s2 = ((uint32_t)h ^ 0x9e3779b9u) * 0x85ebca6bu ^ *s1;
-    return cdl_reverse_bits(cdl_lk_hash(s->rindex, (uint32_t)h));
+    return cdl_reverse_bits(cdl_lk_hash(rindex, (uint32_t)h));
+}
+
+/* The two numbers of a request from its shuffled index. */
+static inline float cdl_sobol_u(uint32_t i, uint32_t s1)
+{
+    return cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(i, s1)));
+}
+
+static inline float cdl_sobol_v(uint32_t i, uint32_t s2)
+{
+    return cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(cdl_sobol_dim1_reversed(i), s2)));
+}
+
+/* Shuffled index for the current dimension. */
+static inline uint32_t cdl_sampler_next(cdl_sampler *s, uint32_t *s1, uint32_t *s2)
+{
+    return cdl_sobol_index(s->key, s->rindex, s->dim++, s1, s2);
 }
 
 static inline float cdl_sampler_1d(cdl_sampler *s)
@@ -110,7 +127,7 @@ static inline float cdl_sampler_1d(cdl_sampler *s)
         return cdl_rng_float(&s->rng);
     uint32_t s1, s2;
     uint32_t i = cdl_sampler_next(s, &s1, &s2);
-    return cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(i, s1)));
+    return cdl_sobol_u(i, s1);
 }
 
 /* A decision that gains nothing from stratification (Russian roulette):
@@ -134,8 +151,58 @@ static inline void cdl_sampler_2d(cdl_sampler *s, float *u, float *v)
     }
     uint32_t s1, s2;
     uint32_t i = cdl_sampler_next(s, &s1, &s2);
-    *u = cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(i, s1)));
-    *v = cdl_u32_to_float(cdl_reverse_bits(cdl_lk_hash(cdl_sobol_dim1_reversed(i), s2)));
+    *u = cdl_sobol_u(i, s1);
+    *v = cdl_sobol_v(i, s2);
+}
+
+/* A path vertex's numbers, requested as 2D, 2D, 1D, 2D (light choice,
+ * point on the light, lobe, direction) and read as u[0..6]. The Sobol
+ * sampler's depend on their dimension alone, so two are left to be
+ * computed if read (cdl_vertex_number_late): a Lambertian vertex never
+ * reads its lobe's (u[4]), nor a choice among lights of equal power its
+ * second (u[1]). The independent sampler's stream keeps its order: all
+ * drawn here. */
+typedef struct cdl_vertex_numbers {
+    float u[7];
+    int sobol;
+    uint64_t key; /* copies: no store the compiler cannot see through changes them */
+    uint32_t rindex, dim;
+} cdl_vertex_numbers;
+
+static inline cdl_vertex_numbers cdl_vertex_numbers_draw(cdl_sampler *s)
+{
+    cdl_vertex_numbers v;
+    v.sobol = s->kind == CDL_SAMPLER_SOBOL;
+    v.key = s->key;
+    v.rindex = s->rindex;
+    v.dim = s->dim;
+    if (v.sobol) {
+        uint32_t s1, s2, i;
+        i = cdl_sobol_index(v.key, v.rindex, v.dim, &s1, &s2);
+        v.u[0] = cdl_sobol_u(i, s1);
+        i = cdl_sobol_index(v.key, v.rindex, v.dim + 1, &s1, &s2);
+        v.u[2] = cdl_sobol_u(i, s1);
+        v.u[3] = cdl_sobol_v(i, s2);
+        i = cdl_sobol_index(v.key, v.rindex, v.dim + 3, &s1, &s2);
+        v.u[5] = cdl_sobol_u(i, s1);
+        v.u[6] = cdl_sobol_v(i, s2);
+        s->dim += 4;
+        return v;
+    }
+    cdl_sampler_2d(s, &v.u[0], &v.u[1]);
+    cdl_sampler_2d(s, &v.u[2], &v.u[3]);
+    v.u[4] = cdl_sampler_1d(s);
+    cdl_sampler_2d(s, &v.u[5], &v.u[6]);
+    return v;
+}
+
+/* u[1] or u[4] (k), the bits cdl_sampler_2d, cdl_sampler_1d gave them. */
+static inline float cdl_vertex_number_late(const cdl_vertex_numbers *v, int k)
+{
+    if (!v->sobol)
+        return v->u[k];
+    uint32_t s1, s2, i = cdl_sobol_index(v->key, v->rindex, v->dim + (k == 1 ? 0 : 2), &s1, &s2);
+    return k == 1 ? cdl_sobol_v(i, s2) : cdl_sobol_u(i, s1);
 }
 
 #endif
