@@ -618,21 +618,8 @@ static inline void triangle_surface(const cdl_scene *s, const uint32_t *t, uint8
     float b0 = 1.0f - b1 - b2;
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
                 *p2 = s->pos + 3 * (size_t)t[2];
-    /* Barycentric position: closer to the surface than o + t d. */
-    cdl_vec3 p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0],
-                        b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
-                        b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
-    cdl_vec3 ns = face_n;
-    if (fl & CDL_TRI_HAS_N) {
-        const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
-                    *n2 = s->nrm + 3 * (size_t)t[2];
-        cdl_vec3 n = cdl_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0],
-                            b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
-                            b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
-        float len = cdl_length(n);
-        if (len > 1e-12f && isfinite(len))
-            ns = cdl_scale(n, 1.0f / len);
-    }
+    cdl_vec3 p, ns;
+    cdl_triangle_point(s, t, fl, face_n, b1, b2, &p, &ns);
     /* stored once, from registers: copying sf->ng to sf->ns read back
      * parts of two stores, a failed store forward on path's chain */
     sf->p = p;
@@ -656,11 +643,7 @@ void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl
     triangle_surface(s, t, fl, face_n, b1, b2, sf);
 }
 
-/* The surface at a hit, world space, with the material's maps applied
- * for the viewing direction (one shading frame for every method). The
- * common case, a plain material on the scene's triangles, makes no call:
- * path does this at every vertex (issue 29). */
-void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+void cdl_surface_at_any(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
     if (h->inst != CDL_NO_INST) {
         cdl_instance_surface(s, h, sf);
