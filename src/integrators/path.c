@@ -107,7 +107,7 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
             cdl_sampler_2d(smp, &u5, &u6);
         }
         cdl_scatter bs;
-        if (!cdl_bsdf_sample(&b, wo, u4, u5, u6, 0, &bs))
+        if (!cdl_bsdf_sample_inline(&b, wo, u4, u5, u6, 0, &bs))
             break;
         beta = cdl_mul(beta, bs.weight);
         specular = bs.delta;

@@ -436,7 +436,7 @@ float cdl_bsdf_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
     return pdf_unperturbed(b, wo, wi) * b->opacity;
 }
 
-int cdl_bsdf_sample_any(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint, cdl_scatter *s)
+int cdl_bsdf_sample(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2, int adjoint, cdl_scatter *s)
 {
     if (b->opacity < 1.0f) {
         if (u0 >= b->opacity) { /* through the mask */
