@@ -133,6 +133,7 @@ static inline int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1
     cdl_sample_triangle(u1, u2, &b1, &b2);
     return cdl_light_triangle_li(l, ref, cdl_light_triangle_at(l, b1, b2), l->L, s);
 }
+
 /* Solid-angle density of cdl_light_sample_li choosing direction wi that
  * reaches the light at distance dist (area and infinite lights; 0 for delta). */
 float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist);
