@@ -31,4 +31,20 @@ static inline uint32_t cdl_alias_sample(const cdl_alias *a, float u_slot, float 
     return k;
 }
 
+/* cdl_alias_sample in two steps, the second number read only where it
+ * matters: a slot of probability 1 (weights all equal, as the triangles
+ * of a quad light) is taken whatever it is (u_accept < 1). */
+static inline uint32_t cdl_alias_slot(const cdl_alias *a, float u_slot)
+{
+    uint32_t i = (uint32_t)((double)u_slot * a->n);
+    return i >= a->n ? a->n - 1 : i;
+}
+
+static inline int cdl_alias_certain(const cdl_alias *a, uint32_t slot) { return a->prob[slot] >= 1.0f; }
+
+static inline uint32_t cdl_alias_take(const cdl_alias *a, uint32_t slot, float u_accept)
+{
+    return u_accept < a->prob[slot] ? slot : a->alias[slot];
+}
+
 #endif

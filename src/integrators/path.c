@@ -31,12 +31,16 @@ static int path_prepare(void *self, const cdl_scene *scene, const cdl_options *o
 /* Direct light at a surface point by light sampling, MIS-weighted
  * against the BSDF having found the same point. */
 static cdl_vec3 next_event(const cdl_scene *s, const cdl_surface *sf, const cdl_bsdf *b,
-                           cdl_vec3 wo, const float *u, uint64_t *rays)
+                           cdl_vec3 wo, const cdl_vertex_numbers *u, uint64_t *rays)
 {
-    float pmf;
-    const cdl_light *l = &s->lights[cdl_alias_sample(&s->light_select, u[0], u[1], &pmf)];
+    const cdl_alias *sel = &s->light_select;
+    uint32_t k = cdl_alias_slot(sel, u->u[0]);
+    if (!cdl_alias_certain(sel, k))
+        k = cdl_alias_take(sel, k, cdl_vertex_number_late(u, 1));
+    float pmf = sel->pmf[k];
+    const cdl_light *l = &s->lights[k];
     cdl_light_sample ls;
-    if (!cdl_light_sample_li(l, sf->p, u[2], u[3], &ls))
+    if (!cdl_light_sample_li(l, sf->p, u->u[2], u->u[3], &ls))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     float pdf_b;
     cdl_vec3 f = cdl_bsdf_eval_pdf(b, wo, ls.wi, 0, &pdf_b);
@@ -91,20 +95,19 @@ static cdl_vec3 radiance(const path_state *ps, cdl_vec3 o, cdl_vec3 d, cdl_sampl
             break;
         cdl_bsdf b;
         cdl_scene_bsdf(s, &sf, &b);
-        /* the vertex's numbers drawn together, in the order they are used:
-         * their hash chains are independent and overlap */
-        float u[7];
-        int nee = !cdl_bsdf_is_delta(&b);
-        if (nee) {
-            cdl_sampler_2d(smp, &u[0], &u[1]);
-            cdl_sampler_2d(smp, &u[2], &u[3]);
+        float u4, u5, u6;
+        if (!cdl_bsdf_is_delta(&b)) {
+            cdl_vertex_numbers u = cdl_vertex_numbers_draw(smp);
+            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, &u, rays)));
+            u4 = cdl_vertex_number_late(&u, 4);
+            u5 = u.u[5];
+            u6 = u.u[6];
+        } else {
+            u4 = cdl_sampler_1d(smp);
+            cdl_sampler_2d(smp, &u5, &u6);
         }
-        u[4] = cdl_sampler_1d(smp);
-        cdl_sampler_2d(smp, &u[5], &u[6]);
-        if (nee)
-            L = cdl_add(L, cdl_mul(beta, next_event(s, &sf, &b, wo, u, rays)));
         cdl_scatter bs;
-        if (!cdl_bsdf_sample(&b, wo, u[4], u[5], u[6], 0, &bs))
+        if (!cdl_bsdf_sample_inline(&b, wo, u4, u5, u6, 0, &bs))
             break;
         beta = cdl_mul(beta, bs.weight);
         specular = bs.delta;

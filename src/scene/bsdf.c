@@ -7,13 +7,15 @@
 #include "scene/microfacet_mts.h"
 #include "scene/plastic.h"
 
-static int is_opaque(const cdl_bsdf *b);
-
 void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
                    cdl_vec3 ns, cdl_vec3 ng)
 {
-    b->type = m->type;
-    b->kd = kd;
+    cdl_bsdf_init_common(b, m, kd, ns, ng);
+    /* Lambert reads none of the other constants: not copying them at every
+     * vertex was a tenth of path's shading time (issue 29). Textured
+     * roughness (cdl_scene_bsdf_maps) may still set ax, ay. */
+    if (b->type == CDL_MAT_DIFFUSE)
+        return;
     b->ks = m->ks;
     b->kt = m->kt;
     b->ns = m->ns;
@@ -28,20 +30,9 @@ void cdl_bsdf_init(cdl_bsdf *b, const cdl_material *m, cdl_vec3 kd,
     b->sigma = m->sigma;
     b->on_full = m->on_full;
     b->coat_t = m->coat_t;
-    b->opacity = m->masked ? cdl_minf(1.0f, cdl_maxf(0.0f, m->opacity)) : 1.0f;
     /* below ~1e-4 the GGX lobe underflows in float */
     b->ax = cdl_maxf(m->alpha_x, 1e-4f);
     b->ay = cdl_maxf(m->alpha_y, 1e-4f);
-    b->ng = ng;
-    /* Shading normal on the geometric normal's side: interpolated normals
-     * of a mesh with flipped winding must not turn the frame inside out. */
-    if (cdl_dot(ns, ng) < 0.0f)
-        ns = cdl_neg(ns);
-    b->frame = cdl_frame_from(ns);
-    b->nb = ns;
-    b->perturbed = 0;
-    b->one_sided = m->one_sided && is_opaque(b);
-    b->p_spec = 0.0f;
     if (b->type == CDL_MAT_PRINCIPLED) /* constants; cdl_scene_bsdf adds textures */
         cdl_principled_at_init(&b->pr, &m->pr, NULL, 0.0f, 0.0f);
     if (b->type == CDL_MAT_PHONG) {
@@ -68,34 +59,6 @@ float cdl_fresnel_dielectric(float cos_i, float eta)
     float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     return 0.5f * (rs * rs + rp * rp);
-}
-
-static int is_opaque(const cdl_bsdf *b)
-{
-    return b->type == CDL_MAT_DIFFUSE || b->type == CDL_MAT_PHONG || b->type == CDL_MAT_CONDUCTOR ||
-           b->type == CDL_MAT_PLASTIC || b->type == CDL_MAT_COATED || b->type == CDL_MAT_ROUGH_COATED ||
-           b->type == CDL_MAT_ROUGH_DIFFUSE;
-}
-
-/* Opaque materials are two-sided: both directions are mirrored to the
- * side wo is on. Returns 0 if wo and wi lie on different geometric sides
- * (light leaking through a surface is never reflected) or either grazes
- * it. */
-static int opaque_local(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi,
-                        cdl_vec3 *lo, cdl_vec3 *li)
-{
-    float go = cdl_dot(wo, b->ng), gi = cdl_dot(wi, b->ng);
-    /* within 1e-6 of the plane the side is rounding: two points of one
-     * sheet of zero thickness, one on each side, must not connect */
-    if (go * gi <= 0.0f || fabsf(go) < 1e-6f || fabsf(gi) < 1e-6f || (b->one_sided && go < 0.0f))
-        return 0;
-    *lo = cdl_to_local(&b->frame, wo);
-    *li = cdl_to_local(&b->frame, wi);
-    if (go < 0.0f) {
-        lo->z = -lo->z;
-        li->z = -li->z;
-    }
-    return lo->z > 0.0f && li->z > 0.0f;
 }
 
 /* Normalized Phong: (n+2)/(2 pi) cos^n(alpha) reflects at most all energy
@@ -231,7 +194,7 @@ static cdl_vec3 eval_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, in
             return cdl_v3(0.0f, 0.0f, 0.0f);
         return rough_glass_eval(b, cdl_to_local(&b->frame, wo), cdl_to_local(&b->frame, wi), adjoint, &pdf);
     }
-    if (!is_opaque(b) || !opaque_local(b, wo, wi, &lo, &li))
+    if (!cdl_mat_is_opaque(b->type) || !cdl_bsdf_opaque_local(b, wo, wi, &lo, &li))
         return cdl_v3(0.0f, 0.0f, 0.0f);
     return opaque_eval(b, lo, li, &pdf);
 }
@@ -250,7 +213,7 @@ static float pdf_unperturbed(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi)
         rough_glass_eval(b, lo, li, 0, &pdf);
         return pdf;
     }
-    if (!is_opaque(b) || !opaque_local(b, wo, wi, &lo, &li))
+    if (!cdl_mat_is_opaque(b->type) || !cdl_bsdf_opaque_local(b, wo, wi, &lo, &li))
         return 0.0f;
     opaque_eval(b, lo, li, &pdf);
     return pdf;
@@ -302,21 +265,16 @@ static int sample_opaque(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1,
     } else {
         li = cdl_sample_cosine_hemisphere(u1, u2);
     }
+    if (b->type == CDL_MAT_DIFFUSE)
+        return cdl_bsdf_sample_lambert(b, go, side, li, s);
     if (li.z <= 0.0f)
         return 0;
     cdl_vec3 wi = cdl_to_world(&b->frame, cdl_v3(li.x, li.y, li.z * side));
     /* The shading frame may send wi below the geometric surface; grazing
-     * as opaque_local (eval and pdf) defines it */
+     * as cdl_bsdf_opaque_local (eval and pdf) defines it */
     float gi = cdl_dot(wi, b->ng);
     if (gi * go <= 0.0f || fabsf(gi) < 1e-6f)
         return 0;
-    if (b->type == CDL_MAT_DIFFUSE) { /* kd/pi cos over cos/pi: no division to wait for */
-        s->wi = wi;
-        s->delta = 0;
-        s->pdf = li.z * CDL_INV_PI;
-        s->weight = b->kd;
-        return 1;
-    }
     float pdf;
     cdl_vec3 f = opaque_eval(b, lo, li, &pdf);
     if (!(pdf > 0.0f))
@@ -456,15 +414,15 @@ cdl_vec3 cdl_bsdf_eval(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint)
 
 /* eval and pdf in one call: one change of frame and one lobe evaluation
  * where the two calls would make them twice (next-event estimation). */
-cdl_vec3 cdl_bsdf_eval_pdf(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint, float *pdf)
+cdl_vec3 cdl_bsdf_eval_pdf_any(const cdl_bsdf *b, cdl_vec3 wo, cdl_vec3 wi, int adjoint, float *pdf)
 {
     cdl_vec3 lo, li, zero = cdl_v3(0.0f, 0.0f, 0.0f);
     *pdf = 0.0f;
-    if (!is_opaque(b) || b->perturbed) {
+    if (!cdl_mat_is_opaque(b->type) || b->perturbed) {
         *pdf = cdl_bsdf_pdf(b, wo, wi);
         return cdl_bsdf_eval(b, wo, wi, adjoint);
     }
-    if (!opaque_local(b, wo, wi, &lo, &li))
+    if (!cdl_bsdf_opaque_local(b, wo, wi, &lo, &li))
         return zero;
     cdl_vec3 f = opaque_eval(b, lo, li, pdf);
     *pdf *= b->opacity;

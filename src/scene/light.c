@@ -24,7 +24,7 @@ static cdl_vec3 triangle_point(const cdl_light *l, float u1, float u2, cdl_vec3 
         float v = l->uv[1] + b1 * (l->uv[3] - l->uv[1]) + b2 * (l->uv[5] - l->uv[1]);
         *L = cdl_mul(*L, tex_eval(l, u, v));
     }
-    return cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+    return cdl_light_triangle_at(l, b1, b2);
 }
 
 /* A texture projected by a spot or projector at Mitsuba's uv, whose v = 0
@@ -167,8 +167,7 @@ static int sample_sphere(const cdl_light *l, cdl_vec3 ref, float u1, float u2, c
     return !cdl_is_black(s->Li) && isfinite(s->pdf);
 }
 
-int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
-                        cdl_light_sample *s)
+int cdl_light_sample_li_any(const cdl_light *l, cdl_vec3 ref, float u1, float u2, cdl_light_sample *s)
 {
     switch (l->type) {
     case CDL_LIGHT_POINT:
@@ -213,23 +212,8 @@ int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
     case CDL_LIGHT_TRIANGLE:
         break;
     }
-    cdl_vec3 Le;
-    s->p = triangle_point(l, u1, u2, &Le);
-    cdl_vec3 d = cdl_sub(s->p, ref);
-    float d2 = cdl_dot(d, d);
-    if (!(d2 > 0.0f))
-        return 0;
-    s->dist = sqrtf(d2);
-    s->wi = cdl_scale(d, 1.0f / s->dist);
-    float cos_l = -cdl_dot(s->wi, l->n);
-    if (l->twosided)
-        cos_l = fabsf(cos_l);
-    if (cos_l <= 0.0f)
-        return 0; /* receiver behind the emitting face */
-    s->Li = Le;
-    s->pdf = d2 / (cos_l * l->area);
-    s->delta = 0;
-    return 1;
+    cdl_vec3 Le, p = triangle_point(l, u1, u2, &Le);
+    return cdl_light_triangle_li(l, ref, p, Le, s);
 }
 
 float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist)

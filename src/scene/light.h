@@ -8,6 +8,7 @@
 
 #include <stdint.h>
 
+#include "core/sampling.h"
 #include "core/vec.h"
 
 typedef enum cdl_light_type {
@@ -89,9 +90,50 @@ static inline int cdl_light_at_infinity(const cdl_light *l)
     return l->type == CDL_LIGHT_DISTANT || l->type == CDL_LIGHT_INFINITE;
 }
 
+/* Triangle light l's point at barycentrics (b1, b2). */
+static inline cdl_vec3 cdl_light_triangle_at(const cdl_light *l, float b1, float b2)
+{
+    return cdl_add(l->p, cdl_add(cdl_scale(l->e1, b1), cdl_scale(l->e2, b2)));
+}
+
+/* The direction, distance and density towards point p (radiance Le) of
+ * triangle light l seen from ref; 0 from behind its emitting face. */
+static inline int cdl_light_triangle_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 p, cdl_vec3 Le,
+                                        cdl_light_sample *s)
+{
+    s->p = p;
+    cdl_vec3 d = cdl_sub(s->p, ref);
+    float d2 = cdl_dot(d, d);
+    if (!(d2 > 0.0f))
+        return 0;
+    s->dist = sqrtf(d2);
+    s->wi = cdl_scale(d, 1.0f / s->dist);
+    float cos_l = -cdl_dot(s->wi, l->n);
+    if (l->twosided)
+        cos_l = fabsf(cos_l);
+    if (cos_l <= 0.0f)
+        return 0; /* receiver behind the emitting face */
+    s->Li = Le;
+    s->pdf = d2 / (cos_l * l->area);
+    s->delta = 0;
+    return 1;
+}
+
+/* Every light; cdl_light_sample_li does an untextured triangle inline
+ * (every vertex of path calls it: the call cost as much as the work). */
+int cdl_light_sample_li_any(const cdl_light *l, cdl_vec3 ref, float u1, float u2, cdl_light_sample *s);
+
 /* Returns 0 if the sample carries no light (back face, outside a cone). */
-int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
-                        cdl_light_sample *s);
+static inline int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
+                                      cdl_light_sample *s)
+{
+    if (l->type != CDL_LIGHT_TRIANGLE || l->tex)
+        return cdl_light_sample_li_any(l, ref, u1, u2, s);
+    float b1, b2;
+    cdl_sample_triangle(u1, u2, &b1, &b2);
+    return cdl_light_triangle_li(l, ref, cdl_light_triangle_at(l, b1, b2), l->L, s);
+}
+
 /* Solid-angle density of cdl_light_sample_li choosing direction wi that
  * reaches the light at distance dist (area and infinite lights; 0 for delta). */
 float cdl_light_pdf_li(const cdl_light *l, cdl_vec3 ref, cdl_vec3 wi, float dist);

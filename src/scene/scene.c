@@ -612,28 +612,19 @@ void cdl_sphere_surface(const float *q, int inward, cdl_vec3 ng, cdl_surface *sf
     sf->geom = CDL_GEOM_SPHERES;
 }
 
-void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1, float b2,
-                          cdl_surface *sf)
+static inline void triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1,
+                                    float b2, cdl_surface *sf)
 {
     float b0 = 1.0f - b1 - b2;
     const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1],
                 *p2 = s->pos + 3 * (size_t)t[2];
-    /* Barycentric position: closer to the surface than o + t d. */
-    sf->p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0],
-                   b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
-                   b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
+    cdl_vec3 p, ns;
+    cdl_triangle_point(s, t, fl, face_n, b1, b2, &p, &ns);
+    /* stored once, from registers: copying sf->ng to sf->ns read back
+     * parts of two stores, a failed store forward on path's chain */
+    sf->p = p;
     sf->ng = face_n;
-    sf->ns = sf->ng;
-    if (fl & CDL_TRI_HAS_N) {
-        const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
-                    *n2 = s->nrm + 3 * (size_t)t[2];
-        cdl_vec3 n = cdl_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0],
-                            b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
-                            b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
-        float len = cdl_length(n);
-        if (len > 1e-12f && isfinite(len))
-            sf->ns = cdl_scale(n, 1.0f / len);
-    }
+    sf->ns = ns;
     sf->u = sf->v = 0.0f;
     sf->dpdu = sf->dpdv = cdl_v3(0.0f, 0.0f, 0.0f);
     if (fl & CDL_TRI_HAS_UV) {
@@ -646,9 +637,13 @@ void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl
     sf->geom = CDL_GEOM_TRIANGLES;
 }
 
-/* The surface at a hit, world space, with the material's maps applied
- * for the viewing direction (one shading frame for every method). */
-void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+void cdl_triangle_surface(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1, float b2,
+                          cdl_surface *sf)
+{
+    triangle_surface(s, t, fl, face_n, b1, b2, sf);
+}
+
+void cdl_surface_at_any(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
 {
     if (h->inst != CDL_NO_INST) {
         cdl_instance_surface(s, h, sf);
@@ -657,17 +652,28 @@ void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
         sf->mat = s->sph_mat[h->prim];
         sf->light = s->sph_light[h->prim];
     } else {
-        cdl_triangle_surface(s, s->idx + 3 * (size_t)h->prim, s->tri_flags[h->prim], s->face_n[h->prim], h->b1,
-                             h->b2, sf);
+        triangle_surface(s, s->idx + 3 * (size_t)h->prim, s->tri_flags[h->prim], s->face_n[h->prim], h->b1, h->b2,
+                         sf);
         sf->mat = s->tri_mat[h->prim];
         sf->light = s->tri_light[h->prim];
     }
     sf->prim = h->prim;
-    cdl_surface_material(s, h, sf);
-    cdl_surface_shade(s, sf, cdl_neg(h->d));
+    const cdl_material *m = &s->mats[sf->mat];
+    if (m->type == CDL_MAT_BLEND || m->hit_kd) {
+        cdl_surface_material(s, h, sf);
+        m = &s->mats[sf->mat];
+    } else {
+        sf->kdh = cdl_v3(1.0f, 1.0f, 1.0f); /* as cdl_surface_material leaves it */
+    }
+    if (cdl_mat_uses_tangent(&m->maps, m->alpha_x, m->alpha_y)) {
+        cdl_surface_shade(s, sf, cdl_neg(h->d));
+    } else { /* as cdl_surface_shade leaves it */
+        sf->nb = sf->ns;
+        sf->ts = cdl_v3(0.0f, 0.0f, 0.0f);
+    }
 }
 
-void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
+void cdl_scene_bsdf_any(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
 {
     const cdl_material *m = &s->mats[sf->mat];
     cdl_vec3 kd = m->kd;

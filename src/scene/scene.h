@@ -272,14 +272,75 @@ void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
                          const cdl_vec3 *d, const float *tmax, uint32_t skip_sphere,
                          uint8_t *blocked);
 
+/* A triangle's point and unit shading normal (face_n without vertex
+ * normals) at barycentrics (b1, b2); t: its vertex indices. The position
+ * is barycentric: closer to the surface than o + t d. */
+static inline void cdl_triangle_point(const cdl_scene *s, const uint32_t *t, uint8_t fl, cdl_vec3 face_n, float b1,
+                                      float b2, cdl_vec3 *p, cdl_vec3 *ns)
+{
+    float b0 = 1.0f - b1 - b2;
+    const float *p0 = s->pos + 3 * (size_t)t[0], *p1 = s->pos + 3 * (size_t)t[1], *p2 = s->pos + 3 * (size_t)t[2];
+    *p = cdl_v3(b0 * p0[0] + b1 * p1[0] + b2 * p2[0], b0 * p0[1] + b1 * p1[1] + b2 * p2[1],
+                b0 * p0[2] + b1 * p1[2] + b2 * p2[2]);
+    *ns = face_n;
+    if (fl & CDL_TRI_HAS_N) {
+        const float *n0 = s->nrm + 3 * (size_t)t[0], *n1 = s->nrm + 3 * (size_t)t[1],
+                    *n2 = s->nrm + 3 * (size_t)t[2];
+        cdl_vec3 n = cdl_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0], b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
+                            b0 * n0[2] + b1 * n1[2] + b2 * n2[2]);
+        float len = cdl_length(n);
+        if (len > 1e-12f && isfinite(len))
+            *ns = cdl_scale(n, 1.0f / len);
+    }
+}
+
 /* The surface at a hit, its shading frame perturbed by the material's bump
- * or normal map (seen along h->d) as every method sees it. */
-void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
+ * or normal map (seen along h->d) as every method sees it: every hit
+ * (_any), and inline a plain material on the scene's triangles without uv
+ * (path does this at every vertex: the call cost as much as the work). */
+void cdl_surface_at_any(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf);
+static inline void cdl_surface_at(const cdl_scene *s, const cdl_hit *h, cdl_surface *sf)
+{
+    if (h->inst == CDL_NO_INST && h->geom == CDL_GEOM_TRIANGLES) {
+        uint32_t prim = h->prim;
+        uint8_t fl = s->tri_flags[prim];
+        const cdl_material *m = &s->mats[s->tri_mat[prim]];
+        if (!(fl & CDL_TRI_HAS_UV) && m->type != CDL_MAT_BLEND && !m->hit_kd &&
+            !cdl_mat_uses_tangent(&m->maps, m->alpha_x, m->alpha_y)) {
+            cdl_vec3 p, ns, zero = cdl_v3(0.0f, 0.0f, 0.0f);
+            cdl_triangle_point(s, s->idx + 3 * (size_t)prim, fl, s->face_n[prim], h->b1, h->b2, &p, &ns);
+            sf->p = p;
+            sf->ng = s->face_n[prim];
+            sf->ns = sf->nb = ns;
+            sf->ts = sf->dpdu = sf->dpdv = zero;
+            sf->u = sf->v = 0.0f;
+            sf->prim = prim;
+            sf->geom = CDL_GEOM_TRIANGLES;
+            sf->mat = s->tri_mat[prim];
+            sf->light = s->tri_light[prim];
+            sf->kdh = cdl_v3(1.0f, 1.0f, 1.0f);
+            return;
+        }
+    }
+    cdl_surface_at_any(s, h, sf);
+}
 /* The tangent frame and bump/normal map of sf's material applied to sf
  * (sf->ns, nb and ts), for a viewer in direction wo (scene/shading.c). */
 void cdl_surface_shade(const cdl_scene *s, cdl_surface *sf, cdl_vec3 wo);
 /* Texture lookup folded in; the frame is sf's ns and ts. */
-void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
+void cdl_scene_bsdf_any(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b);
+/* The same, a plain Lambertian material (no texture, map or tangent
+ * frame) built inline: every vertex of path builds one. */
+static inline void cdl_scene_bsdf(const cdl_scene *s, const cdl_surface *sf, cdl_bsdf *b)
+{
+    const cdl_material *m = &s->mats[sf->mat];
+    if (m->type != CDL_MAT_DIFFUSE || m->hit_kd || m->kd_tex >= 0 || m->maps.on || (m->masked && m->opacity_tex >= 0) ||
+        !cdl_is_black(sf->ts)) {
+        cdl_scene_bsdf_any(s, sf, b);
+        return;
+    }
+    cdl_bsdf_init_common(b, m, m->kd, sf->ns, sf->ng);
+}
 
 /* Origin for a ray leaving p in direction d: pushed off the surface along
  * ng to the side d goes to, so the ray cannot hit the surface it left. */
