@@ -7,11 +7,14 @@
  *  - requests of one pixel, and the same request of neighbouring pixels,
  *    are uncorrelated (the scrambles are independent hashes);
  *  - a fixed seed gives the same numbers; another seed other ones;
- *  - the independent sampler is uniform (mean, variance). */
+ *  - the independent sampler is uniform (mean, variance);
+ *  - a block's samplers started together (core/sampler_block.h, vector
+ *    lanes) give the bits of the one-at-a-time calls. */
 #include <math.h>
 #include <string.h>
 
 #include "core/sampler.h"
+#include "core/sampler_block.h"
 #include "test_util.h"
 
 /* Draws request `dim` (all earlier requests 2D) of pixel `px` at `pass`. */
@@ -141,5 +144,50 @@ int main(void)
     double im = s1 / N, iv = s2 / N - im * im;
     CHECK(fabs(im - 0.5) < 5.0 * sqrt(1.0 / 12.0 / N) && fabs(iv - 1.0 / 12.0) < 0.01,
           "independent sampler: mean %.4f, variance %.4f (1/12 = %.4f)", im, iv, 1.0 / 12.0);
+
+    /* block start against one sampler at a time: every lane count, seeds,
+     * passes (high bits too) and streams, then the draws after it */
+    int blocks = 0, same = 0;
+    for (int n = 1; n <= CDL_SAMPLER_BLOCK; n++)
+        for (uint32_t pass = 0; pass < 40; pass++) {
+            uint64_t seed = (uint64_t)n * 0x1234567ULL + pass, stream[CDL_SAMPLER_BLOCK];
+            uint32_t index = pass < 20 ? pass : pass * 0x9e3779b9u;
+            for (int i = 0; i < n; i++)
+                stream[i] = (uint64_t)(pass * 977 + i) * 1000003ULL + ((uint64_t)i << 40);
+            cdl_sampler blk[CDL_SAMPLER_BLOCK];
+            cdl_vertex_numbers pre[CDL_SAMPLER_BLOCK];
+            float jx[CDL_SAMPLER_BLOCK], jy[CDL_SAMPLER_BLOCK];
+            int drawn = cdl_sampler_block_start(blk, n, CDL_SAMPLER_SOBOL, seed, stream, index, jx, jy, pre);
+            for (int i = 0; i < n; i++) {
+                cdl_sampler s;
+                float x, y;
+                cdl_sampler_start(&s, CDL_SAMPLER_SOBOL, seed, stream[i], index);
+                cdl_sampler_2d(&s, &x, &y);
+                cdl_vertex_numbers vn = cdl_vertex_numbers_draw(&s);
+                cdl_vertex_numbers_taken(&blk[i]);
+                float a1, b1, a2, b2;
+                cdl_sampler_2d(&s, &a1, &b1);
+                cdl_sampler_2d(&blk[i], &a2, &b2);
+                int ok = drawn && x == jx[i] && y == jy[i] && s.key == blk[i].key && s.dim == blk[i].dim &&
+                         a1 == a2 && b1 == b2;
+                for (int k = 0; k < 7; k++)
+                    ok &= cdl_vertex_number_late(&vn, k == 1 || k == 4 ? k : 0) ==
+                              cdl_vertex_number_late(&pre[i], k == 1 || k == 4 ? k : 0) &&
+                          (k == 1 || k == 4 || vn.u[k] == pre[i].u[k]);
+                blocks++;
+                same += ok;
+            }
+        }
+    CHECK(same == blocks, "block start gives the one-at-a-time numbers in %d of %d lanes", same, blocks);
+    cdl_sampler ib[2];
+    cdl_vertex_numbers ipre[2];
+    float ix[2], iy[2];
+    uint64_t ist[2] = {5, 6};
+    int idrawn = cdl_sampler_block_start(ib, 2, CDL_SAMPLER_INDEPENDENT, 1, ist, 3, ix, iy, ipre);
+    cdl_sampler is;
+    cdl_sampler_start(&is, CDL_SAMPLER_INDEPENDENT, 1, 6, 3);
+    float ia, ibv;
+    cdl_sampler_2d(&is, &ia, &ibv);
+    CHECK(!idrawn && ix[1] == ia && iy[1] == ibv, "independent sampler: block start draws only the first request");
     return test_failures ? 1 : 0;
 }

@@ -216,9 +216,11 @@ static inline cdl_vertex_numbers cdl_vertex_numbers_draw(cdl_sampler *s)
         cdl_sobol_uv(x, s1, s2, &v.u[2], &v.u[3]);
         x = cdl_sobol_hash(v.key, v.rindex, v.dim + 3, &s1, &s2);
         cdl_sobol_uv(x, s1, s2, &v.u[5], &v.u[6]);
+        v.u[1] = v.u[4] = 0.0f; /* never read: cdl_vertex_number_late */
         s->dim += 4;
         return v;
     }
+    v.x0 = v.s2 = 0;
     cdl_sampler_2d(s, &v.u[0], &v.u[1]);
     cdl_sampler_2d(s, &v.u[2], &v.u[3]);
     v.u[4] = cdl_sampler_1d(s);

@@ -542,6 +542,91 @@ int cdl_scene_commit(cdl_scene *s, cdl_error *err)
     return 0;
 }
 
+void cdl_intersect_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cdl_vec3 *d,
+                          cdl_hit *h, uint8_t *found)
+{
+    if (s->ninsts) {
+        for (int i = 0; i < n; i++)
+            found[i] = (uint8_t)cdl_intersect(s, o[i], d[i], FLT_MAX, &h[i]);
+        return;
+    }
+    struct RTCRayHit16 rh;
+    int valid[16];
+    for (int i = 0; i < 16; i++) {
+        int k = i < n ? i : 0; /* inactive lanes copy ray 0: no garbage in the packet */
+        valid[i] = i < n ? -1 : 0;
+        rh.ray.org_x[i] = o[k].x;
+        rh.ray.org_y[i] = o[k].y;
+        rh.ray.org_z[i] = o[k].z;
+        rh.ray.dir_x[i] = d[k].x;
+        rh.ray.dir_y[i] = d[k].y;
+        rh.ray.dir_z[i] = d[k].z;
+        rh.ray.tnear[i] = 0.0f;
+        rh.ray.tfar[i] = FLT_MAX;
+        rh.ray.mask[i] = 0xFFFFFFFFu;
+        rh.ray.flags[i] = 0;
+        rh.ray.time[i] = 0.0f;
+        rh.ray.id[i] = (unsigned)i;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect16(valid, s->rtc, &ctx, &rh);
+    for (int i = 0; i < n; i++) {
+        found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (!found[i])
+            continue;
+        h[i].t = rh.ray.tfar[i];
+        h[i].b1 = rh.hit.u[i];
+        h[i].b2 = rh.hit.v[i];
+        h[i].prim = rh.hit.primID[i];
+        h[i].geom = rh.hit.geomID[i];
+        h[i].inst = CDL_NO_INST;
+        h[i].ng = cdl_v3(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]);
+        h[i].d = d[i];
+    }
+}
+
+void cdl_occluded_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cdl_vec3 *d,
+                         const float *tmax, const uint32_t *skip, uint8_t *blocked)
+{
+    int same = 1;
+    for (int i = 1; i < n; i++)
+        same &= skip[i] == skip[0];
+    if (n < 2 || !same || s->ninsts) {
+        for (int i = 0; i < n; i++)
+            blocked[i] = (uint8_t)cdl_occluded_skip(s, o[i], d[i], tmax[i], skip[i]);
+        return;
+    }
+    struct RTCRay16 r;
+    int valid[16];
+    for (int i = 0; i < 16; i++) {
+        int k = i < n ? i : 0; /* inactive lanes copy ray 0 */
+        valid[i] = i < n ? -1 : 0;
+        r.org_x[i] = o[k].x;
+        r.org_y[i] = o[k].y;
+        r.org_z[i] = o[k].z;
+        r.dir_x[i] = d[k].x;
+        r.dir_y[i] = d[k].y;
+        r.dir_z[i] = d[k].z;
+        r.tnear[i] = 0.0f;
+        r.tfar[i] = tmax[k];
+        r.mask[i] = 0xFFFFFFFFu;
+        r.flags[i] = 0;
+        r.time[i] = 0.0f;
+        r.id[i] = (unsigned)i;
+    }
+    cdl_shadow_ctx sc;
+    rtcInitIntersectContext(&sc.ctx);
+    sc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    sc.skip_sphere = skip[0];
+    rtcOccluded16(valid, s->rtc, &sc.ctx, &r);
+    for (int i = 0; i < n; i++)
+        blocked[i] = r.tfar[i] < 0.0f;
+}
+
 void cdl_occluded_bundle(const cdl_scene *s, uint32_t n, const cdl_vec3 *o,
                          const cdl_vec3 *d, const float *tmax, uint32_t skip_sphere,
                          uint8_t *blocked)

@@ -265,6 +265,19 @@ static inline int cdl_occluded(const cdl_scene *s, cdl_vec3 o, cdl_vec3 d, float
     return cdl_occluded_skip(s, o, d, tmax, UINT32_MAX);
 }
 
+/* Closest hits of n <= 16 coherent rays (a block of camera rays) as one
+ * Embree packet; found[i] = 0 where ray i misses. Scenes with instances
+ * trace them one by one (coherent queries through Embree 3's instances can
+ * be very slow). */
+void cdl_intersect_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cdl_vec3 *d,
+                          cdl_hit *h, uint8_t *found);
+
+/* Occlusion of n <= 16 coherent shadow rays (from neighbouring points to
+ * one light) as one Embree packet where they skip the same sphere (else,
+ * and with instances, one by one): blocked[i] = 1 where ray i is blocked. */
+void cdl_occluded_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cdl_vec3 *d,
+                         const float *tmax, const uint32_t *skip, uint8_t *blocked);
+
 /* A bundle of shadow rays traced together as an Embree ray stream
  * (coherent when they share an end point, as the point-light methods'
  * bundles do). Sets hit[i] = 1 where ray i is blocked. */
