@@ -171,7 +171,7 @@ static void test_triangle(void)
     dvec nr = dscale(n, -1.0); /* receiver facing the light */
     for (int s = 0; s < NTRI; s++) {
         float u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
-        cdl_light_sample ls;
+        cdl_light_sample ls = {0};
         if (!cdl_light_sample_li(&l, ref, u1, u2, &ls)) {
             fails++;
             continue;
@@ -276,7 +276,7 @@ static void test_triangle(void)
     long ok_behind = 0;
     cdl_rng_seed(&rng, 0x11647ULL, 3);
     for (int s = 0; s < 10000; s++) {
-        cdl_light_sample ls;
+        cdl_light_sample ls = {0};
         float u1 = cdl_rng_float(&rng), u2 = cdl_rng_float(&rng);
         ok_behind += cdl_light_sample_li(&l, to_f(behind), u1, u2, &ls);
     }
@@ -368,7 +368,7 @@ static void test_point(void)
     dvec pl = from_f(l.p);
     dvec refs[3] = {dv(1.5, -0.4, 0.9), dv(0.3, 0.7, 2.8), dv(-4.0, 2.0, -1.0)};
     for (int i = 0; i < 3; i++) {
-        cdl_light_sample ls;
+        cdl_light_sample ls = {0};
         int ok = cdl_light_sample_li(&l, to_f(refs[i]), 0.3f, 0.6f, &ls);
         dvec d = dsub(pl, refs[i]);
         double d2 = ddot(d, d), dist = sqrt(d2);

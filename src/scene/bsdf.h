@@ -149,8 +149,15 @@ static inline int cdl_bsdf_sample_lambert(const cdl_bsdf *b, float go, float sid
 static inline int cdl_bsdf_sample_inline(const cdl_bsdf *b, cdl_vec3 wo, float u0, float u1, float u2,
                                          int adjoint, cdl_scatter *s)
 {
-    if (b->type != CDL_MAT_DIFFUSE || b->perturbed || b->opacity < 1.0f)
-        return cdl_bsdf_sample(b, wo, u0, u1, u2, adjoint, s);
+    if (b->type != CDL_MAT_DIFFUSE || b->perturbed || b->opacity < 1.0f) {
+        /* through a copy: *s, whose address the call does not take, can
+         * stay in registers (path read wi back through memory, and the
+         * 8-byte load of 4-byte stores stalled: 3 % of its time) */
+        cdl_scatter t;
+        int ok = cdl_bsdf_sample(b, wo, u0, u1, u2, adjoint, &t);
+        *s = t;
+        return ok;
+    }
     float go = cdl_dot(wo, b->ng);
     if (fabsf(go) < 1e-6f || (b->one_sided && go < 0.0f))
         return 0;

@@ -127,8 +127,12 @@ int cdl_light_sample_li_any(const cdl_light *l, cdl_vec3 ref, float u1, float u2
 static inline int cdl_light_sample_li(const cdl_light *l, cdl_vec3 ref, float u1, float u2,
                                       cdl_light_sample *s)
 {
-    if (l->type != CDL_LIGHT_TRIANGLE || l->tex)
-        return cdl_light_sample_li_any(l, ref, u1, u2, s);
+    if (l->type != CDL_LIGHT_TRIANGLE || l->tex) {
+        cdl_light_sample t = {0}; /* a copy keeps *s in registers (see cdl_bsdf_sample_inline) */
+        int ok = cdl_light_sample_li_any(l, ref, u1, u2, &t);
+        *s = t;
+        return ok;
+    }
     float b1, b2;
     cdl_sample_triangle(u1, u2, &b1, &b2);
     return cdl_light_triangle_li(l, ref, cdl_light_triangle_at(l, b1, b2), l->L, s);
