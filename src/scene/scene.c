@@ -551,7 +551,7 @@ void cdl_intersect_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cd
         return;
     }
     struct RTCRayHit16 rh;
-    int valid[16];
+    _Alignas(64) int valid[16]; /* Embree reads it with aligned loads */
     for (int i = 0; i < 16; i++) {
         int k = i < n ? i : 0; /* inactive lanes copy ray 0: no garbage in the packet */
         valid[i] = i < n ? -1 : 0;
@@ -601,7 +601,7 @@ void cdl_occluded_packet(const cdl_scene *s, int n, const cdl_vec3 *o, const cdl
         return;
     }
     struct RTCRay16 r;
-    int valid[16];
+    _Alignas(64) int valid[16]; /* Embree reads it with aligned loads */
     for (int i = 0; i < 16; i++) {
         int k = i < n ? i : 0; /* inactive lanes copy ray 0 */
         valid[i] = i < n ? -1 : 0;
