@@ -72,6 +72,16 @@ static double correlation(const float *a, const float *b, int n)
     return sab / sqrt(saa * sbb);
 }
 
+/* The seven numbers of two draws, the late ones included. */
+static int same_numbers(const cdl_vertex_numbers *a, const cdl_vertex_numbers *b)
+{
+    int k[5] = {0, 2, 3, 5, 6}, ok = 1;
+    for (int i = 0; i < 5; i++)
+        ok &= a->u[k[i]] == b->u[k[i]];
+    return ok && cdl_vertex_number_late(a, 1) == cdl_vertex_number_late(b, 1) &&
+           cdl_vertex_number_late(a, 4) == cdl_vertex_number_late(b, 4);
+}
+
 int main(void)
 {
     /* nets: pixels, requests and sizes, the first blocks and a later one */
@@ -146,7 +156,9 @@ int main(void)
           "independent sampler: mean %.4f, variance %.4f (1/12 = %.4f)", im, iv, 1.0 / 12.0);
 
     /* block start against one sampler at a time: every lane count, seeds,
-     * passes (high bits too) and streams, then the draws after it */
+     * passes (high bits too) and streams, three vertices drawn ahead, then
+     * the draws after them */
+    enum { NV = 3 };
     int blocks = 0, same = 0;
     for (int n = 1; n <= CDL_SAMPLER_BLOCK; n++)
         for (uint32_t pass = 0; pass < 40; pass++) {
@@ -155,25 +167,26 @@ int main(void)
             for (int i = 0; i < n; i++)
                 stream[i] = (uint64_t)(pass * 977 + i) * 1000003ULL + ((uint64_t)i << 40);
             cdl_sampler blk[CDL_SAMPLER_BLOCK];
-            cdl_vertex_numbers pre[CDL_SAMPLER_BLOCK];
+            cdl_vertex_numbers pre[CDL_SAMPLER_BLOCK * NV];
             float jx[CDL_SAMPLER_BLOCK], jy[CDL_SAMPLER_BLOCK];
-            int drawn = cdl_sampler_block_start(blk, n, CDL_SAMPLER_SOBOL, seed, stream, index, jx, jy, pre);
+            int drawn = cdl_sampler_block_start(blk, n, CDL_SAMPLER_SOBOL, seed, stream, index, jx, jy, pre, NV);
             for (int i = 0; i < n; i++) {
                 cdl_sampler s;
                 float x, y;
                 cdl_sampler_start(&s, CDL_SAMPLER_SOBOL, seed, stream[i], index);
                 cdl_sampler_2d(&s, &x, &y);
-                cdl_vertex_numbers vn = cdl_vertex_numbers_draw(&s);
-                cdl_vertex_numbers_taken(&blk[i]);
+                int ok = drawn && x == jx[i] && y == jy[i] && s.key == blk[i].key && s.dim == blk[i].dim;
+                for (int j = 0; j < NV; j++) {
+                    const cdl_vertex_numbers *p = cdl_vertex_numbers_at(&blk[i], &pre[i * NV], NV);
+                    cdl_vertex_numbers vn = cdl_vertex_numbers_draw(&s);
+                    ok &= p == &pre[i * NV + j] && p && same_numbers(&vn, p);
+                    cdl_vertex_numbers_taken(&blk[i]);
+                }
+                ok &= cdl_vertex_numbers_at(&blk[i], &pre[i * NV], NV) == NULL;
                 float a1, b1, a2, b2;
                 cdl_sampler_2d(&s, &a1, &b1);
                 cdl_sampler_2d(&blk[i], &a2, &b2);
-                int ok = drawn && x == jx[i] && y == jy[i] && s.key == blk[i].key && s.dim == blk[i].dim &&
-                         a1 == a2 && b1 == b2;
-                for (int k = 0; k < 7; k++)
-                    ok &= cdl_vertex_number_late(&vn, k == 1 || k == 4 ? k : 0) ==
-                              cdl_vertex_number_late(&pre[i], k == 1 || k == 4 ? k : 0) &&
-                          (k == 1 || k == 4 || vn.u[k] == pre[i].u[k]);
+                ok &= s.dim == blk[i].dim && a1 == a2 && b1 == b2;
                 blocks++;
                 same += ok;
             }
@@ -183,7 +196,7 @@ int main(void)
     cdl_vertex_numbers ipre[2];
     float ix[2], iy[2];
     uint64_t ist[2] = {5, 6};
-    int idrawn = cdl_sampler_block_start(ib, 2, CDL_SAMPLER_INDEPENDENT, 1, ist, 3, ix, iy, ipre);
+    int idrawn = cdl_sampler_block_start(ib, 2, CDL_SAMPLER_INDEPENDENT, 1, ist, 3, ix, iy, ipre, 1);
     cdl_sampler is;
     cdl_sampler_start(&is, CDL_SAMPLER_INDEPENDENT, 1, 6, 3);
     float ia, ibv;

@@ -169,8 +169,13 @@ __attribute__((always_inline)) static inline int scatter(const path_state *ps, p
     return !cdl_is_black(r->beta);
 }
 
-/* The rest of path r, one ray at a time. */
-static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, uint64_t *rays)
+/* Vertices whose numbers a block draws ahead in vector lanes. */
+enum { PATH_AHEAD = 3 };
+
+/* The rest of path r, one ray at a time; pre: its numbers drawn ahead
+ * (cdl_sampler_block_start) or NULL. */
+static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, const cdl_vertex_numbers *pre,
+                  uint64_t *rays)
 {
     const cdl_scene *s = ps->scene;
     for (;;) {
@@ -178,7 +183,7 @@ static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, uint64_t 
         path_vertex v;
         (*rays)++;
         int found = cdl_intersect(s, r->o, r->d, FLT_MAX, &h);
-        if (!shade(ps, r, &h, found, smp, NULL, &v, 0, rays))
+        if (!shade(ps, r, &h, found, smp, cdl_vertex_numbers_at(smp, pre, PATH_AHEAD), &v, 0, rays))
             return;
         if (!scatter(ps, r, &v, smp))
             return;
@@ -207,7 +212,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             int px[B * B], py[B * B], lane[B * B], n = 0, m = 0;
             uint8_t found[B * B], live[B * B], blocked[B * B];
             uint64_t stream[B * B];
-            cdl_vertex_numbers pre[B * B];
+            cdl_vertex_numbers pre[B * B * PATH_AHEAD];
             float jx[B * B], jy[B * B];
             for (int y = by; y < by + B && y < y1; y++)
                 for (int x = bx; x < bx + B && x < x1; x++, n++) {
@@ -215,7 +220,8 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                     px[n] = x;
                     py[n] = y;
                 }
-            int drawn = cdl_sampler_block_start(smp, n, ps->opt.sampler, ps->opt.seed, stream, pass, jx, jy, pre);
+            int drawn = cdl_sampler_block_start(smp, n, ps->opt.sampler, ps->opt.seed, stream, pass, jx, jy, pre,
+                                                PATH_AHEAD);
             for (int k = 0; k < n; k++) {
                 float fx, fy;
                 cdl_camera_sample(cam, px[k], py[k], jx[k], jy[k], &fx, &fy, &w[k]);
@@ -225,7 +231,8 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             *rays += (uint64_t)n;
             cdl_intersect_packet(ps->scene, n, o, d, h, found);
             for (int k = 0; k < n; k++) {
-                live[k] = (uint8_t)shade(ps, &r[k], &h[k], found[k], &smp[k], drawn ? &pre[k] : NULL, &v[k], 1, rays);
+                const cdl_vertex_numbers *row = drawn ? &pre[k * PATH_AHEAD] : NULL;
+                live[k] = (uint8_t)shade(ps, &r[k], &h[k], found[k], &smp[k], row, &v[k], 1, rays);
                 if (live[k] && v[k].shadow) {
                     so[m] = v[k].so;
                     sd[m] = v[k].sd;
@@ -240,7 +247,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                     r[lane[j]].L = cdl_add(r[lane[j]].L, v[lane[j]].C);
             for (int k = 0; k < n; k++) {
                 if (live[k] && scatter(ps, &r[k], &v[k], &smp[k]))
-                    trace(ps, &r[k], &smp[k], rays);
+                    trace(ps, &r[k], &smp[k], drawn ? &pre[k * PATH_AHEAD] : NULL, rays);
                 cdl_vec3 L = r[k].L;
                 bad += (uint64_t)cdl_film_add(film, px[k], py[k], w[k] == 1.0f ? L : cdl_scale(L, w[k]));
             }
