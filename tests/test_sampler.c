@@ -167,22 +167,21 @@ int main(void)
             for (int i = 0; i < n; i++)
                 stream[i] = (uint64_t)(pass * 977 + i) * 1000003ULL + ((uint64_t)i << 40);
             cdl_sampler blk[CDL_SAMPLER_BLOCK];
-            cdl_vertex_numbers pre[CDL_SAMPLER_BLOCK * NV];
+            cdl_numbers_ahead ahead;
             float jx[CDL_SAMPLER_BLOCK], jy[CDL_SAMPLER_BLOCK];
-            int drawn = cdl_sampler_block_start(blk, n, CDL_SAMPLER_SOBOL, seed, stream, index, jx, jy, pre, NV);
+            cdl_sampler_block_start(blk, n, CDL_SAMPLER_SOBOL, seed, stream, index, jx, jy, &ahead, NV);
             for (int i = 0; i < n; i++) {
                 cdl_sampler s;
                 float x, y;
                 cdl_sampler_start(&s, CDL_SAMPLER_SOBOL, seed, stream[i], index);
                 cdl_sampler_2d(&s, &x, &y);
-                int ok = drawn && x == jx[i] && y == jy[i] && s.key == blk[i].key && s.dim == blk[i].dim;
+                int ok = ahead.nv == NV && x == jx[i] && y == jy[i] && s.key == blk[i].key && s.dim == blk[i].dim;
                 for (int j = 0; j < NV; j++) {
-                    const cdl_vertex_numbers *p = cdl_vertex_numbers_at(&blk[i], &pre[i * NV], NV);
-                    cdl_vertex_numbers vn = cdl_vertex_numbers_draw(&s);
-                    ok &= p == &pre[i * NV + j] && p && same_numbers(&vn, p);
-                    cdl_vertex_numbers_taken(&blk[i]);
+                    cdl_vertex_numbers p, vn = cdl_vertex_numbers_draw(&s);
+                    ok &= cdl_numbers_ahead_take(&ahead, i, &blk[i], &p) && same_numbers(&vn, &p);
                 }
-                ok &= cdl_vertex_numbers_at(&blk[i], &pre[i * NV], NV) == NULL;
+                cdl_vertex_numbers none;
+                ok &= !cdl_numbers_ahead_take(&ahead, i, &blk[i], &none);
                 float a1, b1, a2, b2;
                 cdl_sampler_2d(&s, &a1, &b1);
                 cdl_sampler_2d(&blk[i], &a2, &b2);
@@ -193,14 +192,15 @@ int main(void)
         }
     CHECK(same == blocks, "block start gives the one-at-a-time numbers in %d of %d lanes", same, blocks);
     cdl_sampler ib[2];
-    cdl_vertex_numbers ipre[2];
+    cdl_numbers_ahead iahead;
     float ix[2], iy[2];
     uint64_t ist[2] = {5, 6};
-    int idrawn = cdl_sampler_block_start(ib, 2, CDL_SAMPLER_INDEPENDENT, 1, ist, 3, ix, iy, ipre, 1);
+    cdl_sampler_block_start(ib, 2, CDL_SAMPLER_INDEPENDENT, 1, ist, 3, ix, iy, &iahead, 2);
     cdl_sampler is;
     cdl_sampler_start(&is, CDL_SAMPLER_INDEPENDENT, 1, 6, 3);
     float ia, ibv;
     cdl_sampler_2d(&is, &ia, &ibv);
-    CHECK(!idrawn && ix[1] == ia && iy[1] == ibv, "independent sampler: block start draws only the first request");
+    CHECK(iahead.nv == 0 && ix[1] == ia && iy[1] == ibv,
+          "independent sampler: block start draws only the first request");
     return test_failures ? 1 : 0;
 }

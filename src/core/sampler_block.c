@@ -77,9 +77,11 @@ static inline void sobol_uv16(__m512i x, __m512i s1, __m512i s2, __m512 *u, __m5
 }
 #endif
 
-int cdl_sampler_block_start(cdl_sampler *smp, int n, cdl_sampler_kind kind, uint64_t seed, const uint64_t *stream,
-                            uint32_t index, float *jx, float *jy, cdl_vertex_numbers *vn, int nv)
+void cdl_sampler_block_start(cdl_sampler *smp, int n, cdl_sampler_kind kind, uint64_t seed, const uint64_t *stream,
+                             uint32_t index, float *jx, float *jy, cdl_numbers_ahead *ahead, int nv)
 {
+    nv = nv < 0 ? 0 : nv > CDL_AHEAD_MAX ? CDL_AHEAD_MAX : nv;
+    ahead->nv = kind == CDL_SAMPLER_SOBOL ? nv : 0;
 #ifdef CDL_BLOCK_VECTOR
     if (kind == CDL_SAMPLER_SOBOL && n > 0 && n <= CDL_SAMPLER_BLOCK) {
         uint64_t st[CDL_SAMPLER_BLOCK];
@@ -114,48 +116,39 @@ int cdl_sampler_block_start(cdl_sampler *smp, int n, cdl_sampler_kind kind, uint
         /* cdl_vertex_numbers_draw at dimension d = 1 + 4 j: requests d
          * (u0, late u1), d + 1 (u2, u3), d + 2 (late u4), d + 3 (u5, u6) */
         for (int j = 0; j < nv; j++) {
-            uint32_t d = 1 + 4 * (uint32_t)j, x0[CDL_SAMPLER_BLOCK], s20[CDL_SAMPLER_BLOCK];
-            float u0[CDL_SAMPLER_BLOCK], u2[CDL_SAMPLER_BLOCK], u3[CDL_SAMPLER_BLOCK];
+            uint32_t d = 1 + 4 * (uint32_t)j;
             x = sobol_hash16(klo, khi, rindex, d, &s1, &s2);
-            _mm512_storeu_si512(x0, x);
-            _mm512_storeu_si512(s20, s2);
-            _mm512_storeu_ps(u0, sobol_u16(x, s1));
+            _mm512_storeu_si512(ahead->x0[j], x);
+            _mm512_storeu_si512(ahead->s2[j], s2);
+            _mm512_storeu_ps(ahead->u0[j], sobol_u16(x, s1));
             x = sobol_hash16(klo, khi, rindex, d + 1, &s1, &s2);
             sobol_uv16(x, s1, s2, &u, &v);
-            _mm512_storeu_ps(u2, u);
-            _mm512_storeu_ps(u3, v);
+            _mm512_storeu_ps(ahead->u2[j], u);
+            _mm512_storeu_ps(ahead->u3[j], v);
             x = sobol_hash16(klo, khi, rindex, d + 3, &s1, &s2);
             sobol_uv16(x, s1, s2, &u, &v);
-            _mm512_storeu_ps(fu, u);
-            _mm512_storeu_ps(fv, v);
-            for (int i = 0; i < n; i++) {
-                cdl_vertex_numbers *w = &vn[i * nv + j];
-                w->sobol = 1;
-                w->key = key[i];
-                w->rindex = rindex;
-                w->dim = d;
-                w->x0 = x0[i];
-                w->s2 = s20[i];
-                w->u[0] = u0[i];
-                w->u[1] = w->u[4] = 0.0f; /* never read: cdl_vertex_number_late */
-                w->u[2] = u2[i];
-                w->u[3] = u3[i];
-                w->u[5] = fu[i];
-                w->u[6] = fv[i];
-            }
+            _mm512_storeu_ps(ahead->u5[j], u);
+            _mm512_storeu_ps(ahead->u6[j], v);
         }
-        return 1;
+        return;
     }
 #endif
     for (int i = 0; i < n; i++) {
         cdl_sampler_start(&smp[i], kind, seed, stream[i], index);
         cdl_sampler_2d(&smp[i], &jx[i], &jy[i]);
-        if (kind == CDL_SAMPLER_SOBOL) {
-            /* drawn on a copy: the sampler advances when they are taken */
-            cdl_sampler c = smp[i];
-            for (int j = 0; j < nv; j++)
-                vn[i * nv + j] = cdl_vertex_numbers_draw(&c);
+        if (kind != CDL_SAMPLER_SOBOL)
+            continue;
+        /* drawn on a copy: the sampler advances when they are taken */
+        cdl_sampler c = smp[i];
+        for (int j = 0; j < nv; j++) {
+            cdl_vertex_numbers w = cdl_vertex_numbers_draw(&c);
+            ahead->x0[j][i] = w.x0;
+            ahead->s2[j][i] = w.s2;
+            ahead->u0[j][i] = w.u[0];
+            ahead->u2[j][i] = w.u[2];
+            ahead->u3[j][i] = w.u[3];
+            ahead->u5[j][i] = w.u[5];
+            ahead->u6[j][i] = w.u[6];
         }
     }
-    return kind == CDL_SAMPLER_SOBOL;
 }

@@ -104,12 +104,12 @@ static cdl_vec3 emitted(const cdl_scene *s, int32_t light, cdl_vec3 o, cdl_vec3 
 }
 
 /* The vertex at ray r's hit h (found = 0: it escaped): its emission and
- * its next-event estimate (defer: see next_event). pre: the vertex's
- * numbers if drawn already (cdl_sampler_block_start), else NULL. Returns
+ * its next-event estimate (defer: see next_event). ahead: the numbers
+ * its block drew ahead for lane (cdl_sampler_block_start) or NULL. Returns
  * 0 where the path ends. */
 __attribute__((always_inline)) static inline int shade(const path_state *ps, path_ray *r, const cdl_hit *h,
-                                                       int found, cdl_sampler *smp, const cdl_vertex_numbers *pre,
-                                                       path_vertex *v, int defer, uint64_t *rays)
+                                                       int found, cdl_sampler *smp, const cdl_numbers_ahead *ahead,
+                                                       int lane, path_vertex *v, int defer, uint64_t *rays)
 {
     const cdl_scene *s = ps->scene;
     v->shadow = 0;
@@ -129,12 +129,8 @@ __attribute__((always_inline)) static inline int shade(const path_state *ps, pat
     cdl_scene_bsdf(s, &v->sf, &v->b);
     if (!cdl_bsdf_is_delta(&v->b)) {
         cdl_vertex_numbers u;
-        if (pre) {
-            u = *pre;
-            cdl_vertex_numbers_taken(smp);
-        } else {
+        if (!ahead || !cdl_numbers_ahead_take(ahead, lane, smp, &u))
             u = cdl_vertex_numbers_draw(smp);
-        }
         next_event(s, v, r->beta, &r->L, &u, defer, rays);
         v->u4 = cdl_vertex_number_late(&u, 4);
         v->u5 = u.u[5];
@@ -172,9 +168,9 @@ __attribute__((always_inline)) static inline int scatter(const path_state *ps, p
 /* Vertices whose numbers a block draws ahead in vector lanes. */
 enum { PATH_AHEAD = 3 };
 
-/* The rest of path r, one ray at a time; pre: its numbers drawn ahead
- * (cdl_sampler_block_start) or NULL. */
-static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, const cdl_vertex_numbers *pre,
+/* The rest of path r (lane of a block that drew numbers ahead), one ray
+ * at a time. */
+static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, const cdl_numbers_ahead *ahead, int lane,
                   uint64_t *rays)
 {
     const cdl_scene *s = ps->scene;
@@ -183,7 +179,7 @@ static void trace(const path_state *ps, path_ray *r, cdl_sampler *smp, const cdl
         path_vertex v;
         (*rays)++;
         int found = cdl_intersect(s, r->o, r->d, FLT_MAX, &h);
-        if (!shade(ps, r, &h, found, smp, cdl_vertex_numbers_at(smp, pre, PATH_AHEAD), &v, 0, rays))
+        if (!shade(ps, r, &h, found, smp, ahead, lane, &v, 0, rays))
             return;
         if (!scatter(ps, r, &v, smp))
             return;
@@ -212,7 +208,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             int px[B * B], py[B * B], lane[B * B], n = 0, m = 0;
             uint8_t found[B * B], live[B * B], blocked[B * B];
             uint64_t stream[B * B];
-            cdl_vertex_numbers pre[B * B * PATH_AHEAD];
+            cdl_numbers_ahead ahead;
             float jx[B * B], jy[B * B];
             for (int y = by; y < by + B && y < y1; y++)
                 for (int x = bx; x < bx + B && x < x1; x++, n++) {
@@ -220,8 +216,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                     px[n] = x;
                     py[n] = y;
                 }
-            int drawn = cdl_sampler_block_start(smp, n, ps->opt.sampler, ps->opt.seed, stream, pass, jx, jy, pre,
-                                                PATH_AHEAD);
+            cdl_sampler_block_start(smp, n, ps->opt.sampler, ps->opt.seed, stream, pass, jx, jy, &ahead, PATH_AHEAD);
             for (int k = 0; k < n; k++) {
                 float fx, fy;
                 cdl_camera_sample(cam, px[k], py[k], jx[k], jy[k], &fx, &fy, &w[k]);
@@ -231,8 +226,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
             *rays += (uint64_t)n;
             cdl_intersect_packet(ps->scene, n, o, d, h, found);
             for (int k = 0; k < n; k++) {
-                const cdl_vertex_numbers *row = drawn ? &pre[k * PATH_AHEAD] : NULL;
-                live[k] = (uint8_t)shade(ps, &r[k], &h[k], found[k], &smp[k], row, &v[k], 1, rays);
+                live[k] = (uint8_t)shade(ps, &r[k], &h[k], found[k], &smp[k], &ahead, k, &v[k], 1, rays);
                 if (live[k] && v[k].shadow) {
                     so[m] = v[k].so;
                     sd[m] = v[k].sd;
@@ -247,7 +241,7 @@ static uint64_t path_tile(void *self, cdl_film *film, int x0, int y0, int x1, in
                     r[lane[j]].L = cdl_add(r[lane[j]].L, v[lane[j]].C);
             for (int k = 0; k < n; k++) {
                 if (live[k] && scatter(ps, &r[k], &v[k], &smp[k]))
-                    trace(ps, &r[k], &smp[k], drawn ? &pre[k * PATH_AHEAD] : NULL, rays);
+                    trace(ps, &r[k], &smp[k], &ahead, k, rays);
                 cdl_vec3 L = r[k].L;
                 bad += (uint64_t)cdl_film_add(film, px[k], py[k], w[k] == 1.0f ? L : cdl_scale(L, w[k]));
             }
