@@ -335,7 +335,8 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
              * is kept whatever the others add (they hide nothing and
              * only stand in front of hiders) */
             for (uint32_t b = 0; b < x->nh; b++)
-                bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].hide);
+                if (x->held[b].hide)
+                    bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].hide);
             uint32_t cand = 0, front = 0;
             for (uint32_t j = 0; j < x->nf; j++)
                 cand |= x->feas[j].mask & ~(keep[j] = splat_mask_filter(&mr, &x->feas[j], &front));
@@ -346,7 +347,8 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
                 if ((int32_t)front >= 0 && (int32_t)front < mr.reach)
                     mr.reach = (int32_t)front + 1;
                 for (uint32_t b = 0; b < x->nh; b++)
-                    bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].mask & ~x->held[b].hide);
+                    if (x->held[b].mask & ~x->held[b].hide)
+                        bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].mask & ~x->held[b].hide);
                 for (uint32_t j = 0; j < x->nf; j++)
                     if (keep[j] != x->feas[j].mask)
                         keep[j] = splat_mask_filter(&mr, &x->feas[j], &front);
