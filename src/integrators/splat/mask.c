@@ -24,7 +24,14 @@
  * weights bit for bit as the traversal without masks). Most rays need no
  * buffer (mask_ray.c: one plane in the frustum, or no sample whose plane
  * has a feasible one behind it); the others rasterize and filter their
- * feasible samples right away. The survivors (weights, and 1 / z if the
+ * feasible samples right away, in two steps: first only the samples that
+ * may hide one (the hiders: about a quarter of the rasterized ones on the
+ * box), and the filter; only if it hides some (candidates), the rest as
+ * near as the farthest front sample that hides one, and the candidates'
+ * batches filtered again. A sample that is no hider hides nothing; it
+ * only stands in front of hiders, so where the first step hides nothing
+ * the full buffer hides nothing, and the cells of the candidates end with
+ * the front samples the full buffer has: the same splats are kept. The survivors (weights, and 1 / z if the
  * occlusion test or the bandwidth AOV reads it, packed to their lanes)
  * are kept per ray, split by tree part; the batch then
  * splats part by part as without masks, each part replaying its rays'
@@ -71,7 +78,8 @@ typedef struct mask_worker {
     float *val;
     mask_seg *seg;
     uint64_t *grid; /* MASK_G^2 cells: distance bits << 32 | sample, UINT64_MAX empty */
-    uint32_t nh, caph, nf, capf, nrec, caprec, nval, capval, nseg, capseg;
+    uint32_t *keep; /* per feasible batch its lanes the mask keeps */
+    uint32_t capk, nh, caph, nf, capf, nrec, caprec, nval, capval, nseg, capseg;
     int oom;
 } mask_worker;
 
@@ -120,6 +128,7 @@ static void worker_free(mask_worker *w)
     free(w->val);
     free(w->seg);
     free(w->grid);
+    free(w->keep);
 }
 
 void splat_mask_free(splat_state *s)
@@ -154,7 +163,7 @@ size_t splat_mask_bytes(const splat_state *s)
         const mask_worker *w = &m->w[i];
         b += (size_t)w->caph * sizeof(mask_held) + (size_t)w->capf * sizeof(mask_feas) +
              (size_t)w->caprec * sizeof(mask_rec) + (size_t)w->capval * sizeof(float) +
-             (size_t)w->capseg * sizeof(mask_seg) + (w->grid ? MASK_G * MASK_G * sizeof(uint64_t) : 0);
+             (size_t)w->capseg * sizeof(mask_seg) + (size_t)w->capk * sizeof(uint32_t) + (w->grid ? MASK_G * MASK_G * sizeof(uint64_t) : 0);
     }
     return b;
 }
@@ -304,10 +313,17 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     float hmax = r->h0 + r->dh * r->len;
     /* a mask if the frustum holds more than one plane, a buffer if one
      * of them may hide a feasible sample */
+    if (cdl_grow((void **)&x->keep, &x->capk, x->nf, sizeof *x->keep)) {
+        x->oom = 1;
+        return;
+    }
+    uint32_t *keep = x->keep;
+    for (uint32_t j = 0; j < x->nf; j++)
+        keep[j] = x->feas[j].mask;
     if (hmax > 0.0f && x->nf && !splat_mask_one_plane(&mr, x->held, x->nh)) {
         bc->masks++;
         splat_mask_reach(&mr, x->feas, x->nf);
-        if (splat_mask_may_hide(&mr, x->held, x->nh, x->feas, x->nf)) {
+        if (splat_mask_hiders(&mr, x->held, x->nh, x->feas, x->nf)) {
             bc->buffers++;
             int g = MASK_G;
             if (2.0f * hmax < (float)g * m->rho)
@@ -315,8 +331,28 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
             mr.g = g < 1 ? 1 : g;
             for (int c = 0; c < mr.g * mr.g; c++)
                 x->grid[c] = UINT64_MAX;
+            /* the hiders first: a sample no hider's front sample hides
+             * is kept whatever the others add (they hide nothing and
+             * only stand in front of hiders) */
             for (uint32_t b = 0; b < x->nh; b++)
-                bc->rasterized += splat_mask_rasterize(&mr, &x->held[b]);
+                if (x->held[b].hide)
+                    bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].hide);
+            uint32_t cand = 0, front = 0;
+            for (uint32_t j = 0; j < x->nf; j++)
+                cand |= x->feas[j].mask & ~(keep[j] = splat_mask_filter(&mr, &x->feas[j], &front));
+            if (cand) {
+                /* the buffer as it would be where a sample may stand in
+                 * front of a hider that hides one (its key no larger), the
+                 * candidates filtered again */
+                if ((int32_t)front >= 0 && (int32_t)front < mr.reach)
+                    mr.reach = (int32_t)front + 1;
+                for (uint32_t b = 0; b < x->nh; b++)
+                    if (x->held[b].mask & ~x->held[b].hide)
+                        bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].mask & ~x->held[b].hide);
+                for (uint32_t j = 0; j < x->nf; j++)
+                    if (keep[j] != x->feas[j].mask)
+                        keep[j] = splat_mask_filter(&mr, &x->feas[j], &front);
+            }
         }
     }
     const cdl_skd_part *parts = s->tree.parts;
@@ -324,13 +360,13 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
     uint32_t p = 0, cur = UINT32_MAX;
     for (uint32_t j = 0; j < x->nf; j++) {
         const mask_feas *fb = &x->feas[j];
-        uint32_t keep = mr.g ? splat_mask_filter(&mr, fb) : fb->mask;
-        bc->masked += (uint64_t)__builtin_popcount(fb->mask & ~keep);
-        if (!keep)
+        const uint32_t kj = keep[j];
+        bc->masked += (uint64_t)__builtin_popcount(fb->mask & ~kj);
+        if (!kj)
             continue;
         while (p + 1 < np && fb->first >= parts[p].hi)
             p++;
-        uint32_t nk = (uint32_t)__builtin_popcount(keep), nv = m->wiz ? 2 * nk : nk;
+        uint32_t nk = (uint32_t)__builtin_popcount(kj), nv = m->wiz ? 2 * nk : nk;
         if (cdl_grow((void **)&x->rec, &x->caprec, x->nrec + 1, sizeof *x->rec) ||
             cdl_grow((void **)&x->val, &x->capval, x->nval + nv, sizeof *x->val)) {
             x->oom = 1;
@@ -345,10 +381,10 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build
             x->seg[cur] = (mask_seg){p, x->nrec, 0};
             m->rnseg[k]++;
         }
-        x->rec[x->nrec++] = (mask_rec){fb->first, keep, x->nval};
-        pack(x->val + x->nval, keep, fb->w);
+        x->rec[x->nrec++] = (mask_rec){fb->first, kj, x->nval};
+        pack(x->val + x->nval, kj, fb->w);
         if (m->wiz)
-            pack(x->val + x->nval + nk, keep, fb->iz);
+            pack(x->val + x->nval + nk, kj, fb->iz);
         x->nval += nv;
         x->seg[cur].n++;
     }

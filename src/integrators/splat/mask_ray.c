@@ -2,7 +2,7 @@
  * is): most rays need no buffer, and the tests that show it are cheaper
  * than the buffer. A frustum holding one plane needs none (one_plane).
  * Nor does one where no sample could hide a feasible one whatever the
- * buffer holds (may_hide): a hider lies nearer than the sample by more
+ * buffer holds (hiders, which also marks the samples that may): a hider lies nearer than the sample by more
  * than its footprint and has the sample behind its tangent plane, and
  * for a hider's normal n the feasible samples' extremes of p . n +- pw
  * bound that for all of them at once; on faceted surfaces a frustum
@@ -228,15 +228,17 @@ static int bound_find(bound *bd, int *nb, const mask_ray *x, const mask_feas *f,
  * more than pw_y, the origin lies off o's plane by more than pw_o and y
  * lies behind it by more than pw_y: (p_y - p_o) . n_o < -pw_y with the
  * origin in front (p_y . n + pw_y < p_o . n), > pw_y with it behind.
- * A lane that may be such an o (by rounding too: eps) answers 1. */
-int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, const mask_feas *f, uint32_t nf)
+ * Every lane that may be such an o (by rounding too: eps) is a hider. */
+int splat_mask_hiders(const mask_ray *x, mask_held *h, uint32_t nh, const mask_feas *f, uint32_t nf)
 {
     const cdl_skd *t = x->t;
     const float eps = x->eps;
     bound bd[BOUNDS];
     int nb = 0;
+    uint32_t any = 0;
     for (uint32_t k = 0; k < nh; k++) {
         const uint32_t b = h[k].first;
+        uint32_t hid = 0;
 #if defined(__AVX512F__)
         lanes16 l = load16(t, b, x->r);
         __m512 pb = _mm512_sub_ps(_mm512_loadu_ps(x->pw + b), _mm512_set1_ps(eps));
@@ -249,17 +251,21 @@ int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, cons
             __mmask16 same = _mm512_mask_cmp_ps_mask(rel, l.nx, _mm512_set1_ps(nx), _CMP_EQ_OQ);
             same = _mm512_mask_cmp_ps_mask(same, l.ny, _mm512_set1_ps(ny), _CMP_EQ_OQ);
             same = _mm512_mask_cmp_ps_mask(same, l.nz, _mm512_set1_ps(nz), _CMP_EQ_OQ);
-            if (!(same >> i & 1u))
-                return 1; /* not a number */
+            if (!(same >> i & 1u)) { /* not a number */
+                hid |= 1u << i;
+                rel &= (__mmask16) ~(1u << i);
+                continue;
+            }
             int e = bound_find(bd, &nb, x, f, nf, nx, ny, nz);
-            if (e < 0)
-                return 1;
+            if (e < 0) {
+                hid |= rel;
+                break;
+            }
             __m512 d = dot16(l.px, l.py, l.pz, nx, ny, nz);
             __mmask16 front = _mm512_mask_cmp_ps_mask(same, l.so, _mm512_set1_ps(eps), _CMP_LT_OQ);
             __mmask16 back = _mm512_mask_cmp_ps_mask(same, l.so, _mm512_set1_ps(-eps), _CMP_GT_OQ);
-            if (_mm512_mask_cmp_ps_mask(front, _mm512_set1_ps(bd[e].lo), _mm512_add_ps(d, _mm512_set1_ps(eps)), _CMP_LT_OQ) |
-                _mm512_mask_cmp_ps_mask(back, _mm512_set1_ps(bd[e].hi), _mm512_sub_ps(d, _mm512_set1_ps(eps)), _CMP_GT_OQ))
-                return 1;
+            hid |= _mm512_mask_cmp_ps_mask(front, _mm512_set1_ps(bd[e].lo), _mm512_add_ps(d, _mm512_set1_ps(eps)), _CMP_LT_OQ) |
+                   _mm512_mask_cmp_ps_mask(back, _mm512_set1_ps(bd[e].hi), _mm512_sub_ps(d, _mm512_set1_ps(eps)), _CMP_GT_OQ);
             rel &= (__mmask16)~same;
         }
 #else
@@ -270,18 +276,16 @@ int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, cons
             float so = (t->p[0][q] - x->r->o.x) * nx + (t->p[1][q] - x->r->o.y) * ny + (t->p[2][q] - x->r->o.z) * nz;
             if (!(fabsf(so) > x->pw[q] - eps) || !((int32_t)float_bits(h[k].z[i] + 0.0f) < x->reach))
                 continue;
-            if (!(nx == nx && ny == ny && nz == nz))
-                return 1;
-            int e = bound_find(bd, &nb, x, f, nf, nx, ny, nz);
-            if (e < 0)
-                return 1;
+            int e = nx == nx && ny == ny && nz == nz ? bound_find(bd, &nb, x, f, nf, nx, ny, nz) : -1;
             float d = t->p[0][q] * nx + t->p[1][q] * ny + t->p[2][q] * nz;
-            if ((so < eps && bd[e].lo < d + eps) || (so > -eps && bd[e].hi > d - eps))
-                return 1;
+            if (e < 0 || (so < eps && bd[e].lo < d + eps) || (so > -eps && bd[e].hi > d - eps))
+                hid |= 1u << i;
         }
 #endif
+        h[k].hide = hid;
+        any |= hid;
     }
-    return 0;
+    return any != 0;
 }
 
 /* z-min of a cell with key (a branch-free select: the loads forward
@@ -350,7 +354,9 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
 }
 #endif
 
-uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
+uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb) { return splat_mask_rasterize_lanes(x, hb, hb->mask); }
+
+uint32_t splat_mask_rasterize_lanes(const mask_ray *x, const mask_held *hb, uint32_t lanes)
 {
     const cdl_skd *t = x->t;
     const cdl_photon_ray *r = x->r;
@@ -363,14 +369,14 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
     uint32_t zk[16], near = 0;
 #if defined(__AVX512F__)
     __m512i zb = _mm512_castps_si512(_mm512_add_ps(_mm512_loadu_ps(zz), _mm512_setzero_ps()));
-    near = _mm512_mask_cmplt_epi32_mask((__mmask16)hb->mask, zb, _mm512_set1_epi32(x->reach));
+    near = _mm512_mask_cmplt_epi32_mask((__mmask16)lanes, zb, _mm512_set1_epi32(x->reach));
     _mm512_storeu_si512(zk, zb);
 #else
     for (int i = 0; i < 16; i++) {
         zk[i] = float_bits(zz[i] + 0.0f);
         near |= (uint32_t)((int32_t)zk[i] < x->reach) << i;
     }
-    near &= hb->mask;
+    near &= lanes;
 #endif
     if (!near)
         return 0;
@@ -469,7 +475,7 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
     return (uint32_t)__builtin_popcount(small | large);
 }
 
-uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
+uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb, uint32_t *front)
 {
     const cdl_skd *t = x->t;
     const uint64_t *grid = x->grid;
@@ -519,14 +525,19 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
     __mmask16 pos = _mm512_cmp_ps_mask(so, zero, _CMP_GT_OQ);
     hide &= (__mmask16)((pos & _mm512_cmp_ps_mask(sy, _mm512_sub_ps(zero, rho), _CMP_LT_OQ)) |
                         (~pos & _mm512_cmp_ps_mask(sy, rho, _CMP_GT_OQ)));
+    if (hide) {
+        uint32_t f = (uint32_t)_mm512_mask_reduce_max_epu32(hide, zk);
+        *front = f > *front ? f : *front;
+    }
     return mask & ~(uint32_t)hide;
 #else
-    uint32_t hit = 0, occ[16];
+    uint32_t hit = 0, occ[16], ozb[16];
     for (int i = 0; i < 16; i++) {
         if (!(mask >> i & 1u) || cell[i] < 0)
             continue;
         uint64_t key = grid[cell[i]];
         occ[i] = (uint32_t)key;
+        ozb[i] = (uint32_t)(key >> 32);
         hit |= (uint32_t)((occ[i] != UINT32_MAX) & (occ[i] != first + (uint32_t)i) &
                           ((int32_t)(uint32_t)(key >> 32) < zb[i])) << i;
     }
@@ -539,8 +550,10 @@ uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb)
         float rho = pw[i], nx = t->nrm[0][o], ny = t->nrm[1][o], nz = t->nrm[2][o];
         float so = (ox - t->p[0][o]) * nx + (oy - t->p[1][o]) * ny + (oz - t->p[2][o]) * nz;
         float sy = (px[i] - t->p[0][o]) * nx + (py[i] - t->p[1][o]) * ny + (pz[i] - t->p[2][o]) * nz;
-        if (fabsf(so) > x->pw[o] && (so > 0.0f ? sy < -rho : sy > rho))
+        if (fabsf(so) > x->pw[o] && (so > 0.0f ? sy < -rho : sy > rho)) {
             keep &= ~(1u << i);
+            *front = ozb[i] > *front ? ozb[i] : *front;
+        }
     }
     return keep;
 #endif

@@ -11,7 +11,7 @@
 /* A traversal batch held until the ray's buffer is known: the frustum's
  * lanes with their z, or the feasible ones with w and 1 / z. */
 typedef struct mask_held {
-    uint32_t first, mask;
+    uint32_t first, mask, hide; /* hide: the lanes that may hide a feasible sample (splat_mask_hiders) */
     float z[16];
 } mask_held;
 typedef struct mask_feas {
@@ -36,12 +36,15 @@ typedef struct mask_ray {
 int splat_mask_one_plane(const mask_ray *x, const mask_held *h, uint32_t nh);
 /* Sets x->reach from the feasible batches. */
 void splat_mask_reach(mask_ray *x, const mask_feas *f, uint32_t nf);
-/* 0 if no held sample can hide any feasible one whatever the buffer
- * (needs x->reach); 1 if some may. */
-int splat_mask_may_hide(const mask_ray *x, const mask_held *h, uint32_t nh, const mask_feas *f, uint32_t nf);
+/* Sets each held batch's hide: its lanes that may hide some feasible
+ * sample whatever the buffer (needs x->reach); returns whether any may. */
+int splat_mask_hiders(const mask_ray *x, mask_held *h, uint32_t nh, const mask_feas *f, uint32_t nf);
 /* One held batch into x->grid; returns the samples it rasterized. */
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb);
-/* The feasible lanes of fb the buffer does not hide. */
-uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb);
+/* The same for its lanes in lanes only. */
+uint32_t splat_mask_rasterize_lanes(const mask_ray *x, const mask_held *hb, uint32_t lanes);
+/* The feasible lanes of fb the buffer does not hide; *front rises to the
+ * largest distance bits (unsigned) of the front samples that hide one. */
+uint32_t splat_mask_filter(const mask_ray *x, const mask_feas *fb, uint32_t *front);
 
 #endif
