@@ -196,8 +196,16 @@ def main(argv):
             bad(f"bench/report.py exited {p.returncode}: {p.stderr.strip().splitlines()[-1:]}")
         else:
             ok("bench/report.py on the renders directory ran")
+            # the first image with a pixel no other image shares: a method
+            # that converges fast enough matches the reference everywhere
+            # within TOL at its longest budget (path did at 0.8 s once
+            # it traced 0.71 of raw Embree's rays per second)
+            names = {f: cdl.read(os.path.join(renders, f)) for f in os.listdir(renders) if f.endswith(".exr")}
+            pick = next(((m, b) for b in sorted(budgets, reverse=True) for m in methods
+                         if f"{m}_{b:g}s_seed1.exr" in names and
+                         pick_pixel(cdl, names, f"{m}_{b:g}s_seed1.exr", -1.0) is not None), ("path", 0.8))
             check_page("directory page", chromium, os.path.join(out2, "index.html"), cdl, renders,
-                       os.path.join(renders, "reference.exr"), "path", 0.8, -1.0, tmp, ids)
+                       os.path.join(renders, "reference.exr"), pick[0], pick[1], -1.0, tmp, ids)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"{len(failures)} failure(s)" if failures else "all checks passed")
