@@ -3,8 +3,7 @@
  * rows z-min in registers) fills the buffer exactly as one cell at a time
  * does, bit for bit, on clustered batches (windows of 1 x 1 to 8 x 8
  * cells), spread ones (the cell by cell path), several grid sizes, and
- * with the reach cutting some lanes; the reach is the largest z - pw of
- * the feasible lanes, as their bits. */
+ * with the reach cutting some lanes. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -75,8 +74,8 @@ int main(void)
     for (int gi = 0; gi < 4; gi++)
         for (int cut = 0; cut < 2; cut++) {
             int g = sizes[gi];
-            mask_ray x0 = {&t, &r, pw, axp, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 1e-5f, g,
-                           cut ? (int32_t)bits(2.0f) : INT32_MAX, g0, 1};
+            mask_ray x0 = {.t = &t, .r = &r, .pw = pw, .ax = axp, .U = {1.0f, 0.0f, 0.0f}, .V = {0.0f, 1.0f, 0.0f},
+                           .eps = 1e-5f, .g = g, .reach = cut ? (int32_t)bits(2.0f) : INT32_MAX, .grid = g0, .plain = 1};
             mask_ray x1 = x0;
             x1.grid = g1, x1.plain = 0;
             for (int c = 0; c < MASK_G * MASK_G; c++)
@@ -97,26 +96,6 @@ int main(void)
                   g, cut ? "cut" : "open", diff, g * g, filled);
         }
 
-    /* the reach over feasible batches: the largest z - pw, 1 / iz the z */
-    mask_feas f[3];
-    memset(f, 0, sizeof f);
-    float want = -INFINITY;
-    for (uint32_t j = 0; j < 3; j++) {
-        f[j].first = 16 * j;
-        f[j].mask = j == 1 ? 0u : 0x5a5au >> j;
-        for (uint32_t i = 0; i < 16; i++) {
-            float z = 0.5f + 3.0f * cdl_rng_float(&rng);
-            f[j].iz[i] = 1.0f / z;
-            if (f[j].mask >> i & 1u)
-                want = fmaxf(want, 1.0f / f[j].iz[i] - pw[16 * j + i]);
-            else
-                f[j].iz[i] = j == 2 ? NAN : 100.0f; /* lanes not fed count for nothing */
-        }
-    }
-    mask_ray xr = {&t, &r, pw, axp, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 1e-5f, 32, 0, g0, 0};
-    splat_mask_reach(&xr, f, 3);
-    CHECK(xr.reach == (int32_t)bits(want), "the reach is the largest z - pw (%.9g, bits %d, want %d)", (double)want,
-          xr.reach, (int32_t)bits(want));
     free(g0);
     free(g1);
     free(held);

@@ -203,8 +203,9 @@ static inline float cdl_splat_weight(const cdl_splat_ray *r, cdl_vec3 p, cdl_vec
 /* Traversal flags: culling nodes honoured; Algorithm 1's 1D slabs (the
  * report's traversal) instead of the default bounding-sphere test per
  * node (the same samples, fewer tested). */
-enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_NOIZ = 8 };
-/* CDL_SKD_NOIZ: a range visit's iz is not wanted (left unwritten). */
+enum { CDL_SKD_CULL = 1, CDL_SKD_SLABS = 2, CDL_SKD_NOIZ = 8, CDL_SKD_ANY = 16 };
+/* CDL_SKD_NOIZ: a range visit's iz is not wanted (left unwritten);
+ * CDL_SKD_ANY: a both visit wants the frustum's lanes only (feasible 0). */
 
 /* The feasible samples of part `part` (UINT32_MAX: the whole tree) found
  * by traversing with the frustum, in batches: samples [first, first + m)

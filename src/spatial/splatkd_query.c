@@ -42,6 +42,7 @@ typedef struct trav {
     float o[3], d[3], inv[3]; /* inv: 1 / |d| per axis (0 where d is 0) */
     float zmax;               /* no sample farther along the ray is fed */
     int cull, slabs, both, iz; /* iz: 1 / z wanted */
+    int any_only;              /* both: the frustum's lanes only (CDL_SKD_ANY) */
     cdl_skd_visit fn;          /* 16 lanes a call, or */
     cdl_skd_visit_range fnr;   /* a range a call, or */
     cdl_skd_visit_both fnb;    /* 16 lanes a call, frustum and feasible */
@@ -101,7 +102,7 @@ static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
         for (uint32_t b = lo; b < hi; b += 16) {
             uint32_t m = hi - b < 16 ? hi - b : 16;
             float z[16], w[16], iz[16];
-            any16 f = {v->zmax, culled, 0, z};
+            any16 f = {v->zmax, culled | v->any_only, 0, z};
             uint32_t feas = v->r->cap > 0.0f ? weigh16(&a, b, m, &L, 1, 1, w, iz, &f)
                                              : weigh16(&a, b, m, &L, 0, 1, w, iz, &f);
             if (f.mask | feas)
@@ -429,7 +430,7 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
         return;
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
-                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, 1, NULL, NULL,
+                    r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, 1, 0, NULL, NULL,
                     NULL, NULL, cnt},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
@@ -459,6 +460,7 @@ static int splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, 
               (flags & CDL_SKD_SLABS) && !fnb, /* the slabs go front to back, not in tree order */
               fnb != NULL,
               !(flags & CDL_SKD_NOIZ),
+              fnb && (flags & CDL_SKD_ANY),
               fn,
               fnr,
               fnb,

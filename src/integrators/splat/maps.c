@@ -197,7 +197,9 @@ typedef struct ray_ctx {
     splat_state *s;
     splat_terms t;
     uint32_t ray;
-    uint64_t splats, occluded, occl_rays;
+    uint64_t splats, occluded, occl_rays, masked;
+    int mk;      /* the ray has a visibility mask: 1, set up in mr: 2 */
+    mask_ray mr;
 } ray_ctx;
 
 #if defined(__AVX512F__)
@@ -359,26 +361,23 @@ static inline void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole
         splat_bandwidth(c, first, m, mask, w, iz);
 }
 
-/* With the visibility mask: a ray's kept splats, in ray order. */
-static void replay_batch(void *ctx, uint32_t ray, uint32_t first, uint32_t mask, const float *w, const float *iz)
-{
-    ray_ctx *c = ctx;
-    if (ray != c->ray) {
-        c->ray = ray;
-        c->t.r = &c->s->rays.r[ray];
-        c->t.ready = 0;
-    }
-    splat_batch(c, first, 16, 0, mask, w, iz);
-}
-
 /* A leaf range from the tree: its 16-lane blocks with feasible samples,
  * without a call each. */
 static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
 {
+    ray_ctx *c = ctx;
     for (uint32_t j = 0; j * 16 < n; j++)
         if (mask[j]) {
-            uint32_t m = n - 16 * j < 16 ? n - 16 * j : 16;
-            splat_batch(ctx, first + 16 * j, m, m == 16, mask[j], w + 16 * j, iz + 16 * j);
+            uint32_t m = n - 16 * j < 16 ? n - 16 * j : 16, k = mask[j];
+            if (c->mk) { /* the visibility mask's filter (set up at the ray's first splat in this part) */
+                if (c->mk == 1)
+                    c->mk = 1 + splat_mask_ray(c->s, c->ray, &c->mr);
+                uint32_t kept = splat_mask_filter(&c->mr, first + 16 * j, k, iz + 16 * j);
+                c->masked += (uint64_t)__builtin_popcount(k & ~kept);
+                if (!(k = kept))
+                    continue;
+            }
+            splat_batch(c, first + 16 * j, m, m == 16, k, w + 16 * j, iz + 16 * j);
         }
 }
 
@@ -407,37 +406,37 @@ void splat_maps_clear(splat_state *s)
 int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
-    uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0;
+    uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0, masked = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0) |
                       (s->mask || s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
-    /* with visibility masks, a batch of rays at a time: one traversal per
-     * ray builds its mask and keeps the splats it lets through, which the
-     * parts then replay */
+    /* with visibility masks, a batch of rays at a time: their buffers
+     * first (the occluders in each frustum), then the splats through them */
     uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
         uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
-        if (s->mask && splat_mask_build(s, k0, k1 - k0, flags))
+        if (s->mask && splat_mask_build(s, k0, k1 - k0))
             return CDL_ERR_SYSTEM;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, occluded, occl_rays)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, occluded, occl_rays, masked)
         for (uint32_t part = 0; part < s->tree.nparts; part++) {
             cdl_skd_count cnt = {0, 0, 0};
             ray_ctx c;
             c.s = s;
             c.ray = UINT32_MAX;
-            c.splats = c.occluded = c.occl_rays = 0;
-            if (s->mask)
-                splat_mask_replay(s, part, replay_batch, &c);
-            for (uint32_t k = k0; k < k1 && !s->mask && !cdl_cancelled(s->cancel); k++) {
+            c.splats = c.occluded = c.occl_rays = c.masked = 0;
+            c.mk = 0;
+            for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
                 cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;
                 c.t.ready = 0;
                 c.ray = k;
+                c.mk = s->mask && splat_mask_has(s, k);
                 cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, splat_range, &c, &cnt);
             }
             splats += c.splats;
+            masked += c.masked;
             occluded += c.occluded;
             occl_rays += c.occl_rays;
             tested += cnt.tested;
@@ -446,6 +445,7 @@ int splat_maps_splat(splat_state *s)
     }
     s->st.splats += splats;
     s->st.occluded += occluded;
+    s->st.masked += masked;
     s->st.occl_rays += occl_rays;
     s->st.tested += tested;
     s->st.nodes += nodes;

@@ -1,108 +1,86 @@
 /* splat's visibility mask (Herzog et al. 2007, §8.1, proposed there as
  * future work): before a photon ray splats, the eye samples inside its
- * frustum, whatever their facing, are rasterized into a small occlusion
- * buffer in the kernel's plane: lateral offsets from the ray divided by
- * the kernel's radius at their depth (the cone's own perspective, so a
- * blocker near the narrow origin hides only what lies behind it), on at
- * most MASK_G x MASK_G cells, no finer than the samples' median
- * footprint. Each sample covers the surface patch its pixel sees (the
- * masking density: an ellipse, longer on surfaces seen at a grazing
- * angle, so a surface leaves no holes), and a cell keeps the sample
- * nearest the ray's origin. A feasible sample is then fed only if the
- * front sample of its cell does not hide it: that occluder lies nearer
- * along the ray and the sample lies behind the occluder's tangent plane
- * (seen from the ray's origin) by more than its own footprint, so a
+ * frustum that may hide others (the occluders, below) are rasterized into
+ * a small occlusion buffer in the kernel's plane: lateral offsets from the
+ * ray divided by the kernel's radius at their depth (the cone's own
+ * perspective, so a blocker near the narrow origin hides only what lies
+ * behind it), on at most MASK_G x MASK_G cells, no finer than the
+ * samples' median footprint. Each sample covers the surface patch its
+ * pixel sees (the masking density: an ellipse, longer on surfaces seen at
+ * a grazing angle, so a surface leaves no holes), and a cell keeps the
+ * occluder nearest the ray's origin. A feasible sample is then fed only if
+ * the front occluder of its cell does not hide it: that occluder lies
+ * nearer along the ray and the sample lies behind the occluder's tangent
+ * plane (seen from the ray's origin) by more than its own footprint, so a
  * surface never shadows its own neighbours. Only occluders the camera sees
  * count (they must be eye samples), as the report says; the surface the
- * ray leaves is no occluder, and a frustum holding one plane's samples
- * only needs no mask.
+ * ray leaves is no occluder.
  *
- * Cost (issue 29): one traversal per ray, as the report rasterizes
- * "during the ray traversal": a batch of rays at a time (splat_mask_batch),
- * in parallel over the rays, each ray's traversal yields the frustum's
- * samples and the feasible ones (cdl_skd_splat_visit_both: the same
- * weights bit for bit as the traversal without masks). Most rays need no
- * buffer (mask_ray.c: one plane in the frustum, or no sample whose plane
- * has a feasible one behind it); the others rasterize and filter their
- * feasible samples right away, in two steps: first only the samples that
- * may hide one (the hiders: about a quarter of the rasterized ones on the
- * box), and the filter; only if it hides some (candidates), the rest as
- * near as the farthest front sample that hides one, and the candidates'
- * batches filtered again. A sample that is no hider hides nothing; it
- * only stands in front of hiders, so where the first step hides nothing
- * the full buffer hides nothing, and the cells of the candidates end with
- * the front samples the full buffer has: the same splats are kept. The survivors (weights, and 1 / z if the
- * occlusion test or the bandwidth AOV reads it, packed to their lanes)
- * are kept per ray, split by tree part; the batch then
- * splats part by part as without masks, each part replaying its rays'
- * kept splats in ray order, so every sample sums its splats in the same
- * order and the image is the one two traversals gave. A cell holds its
- * front sample as one 64-bit key, distance bits over the sample's index
- * (z >= 0: the float's bits order as the float), so z-min with the
- * index's tie-break is one unsigned min. On the Cornell box (global
- * light, 250000 photon rays) the kept splats of 8192 rays take about 70
- * MiB (of 4096 with 1 / z), the buffers 8 KiB per thread; a batch ends
- * in two barriers, where a thread another process holds up keeps the
- * other waiting (half as many batches: 10 % less time on a loaded
- * machine). */
+ * The occluders: an eye sample can hide another only if some eye sample
+ * lies behind its tangent plane by more than that one's footprint, as seen
+ * from some ray origin of the pass in front of it by more than its own
+ * (or the same with the sides swapped). In a room the walls, floor and
+ * ceiling bound everything and never can; the furniture, thin walls and
+ * doors can. prepare finds them once a pass (bounds of 64 samples, then of
+ * 4096, prune the search; the ray origins' box stands for the origins)
+ * and puts them under a tree of their own, with the sides they may hide
+ * from. A sample that can hide nothing is no occluder at all: it neither
+ * hides nor stands in front of an occluder to unveil what lies behind both.
+ *
+ * Cost (issue 29): a batch of rays at a time, in parallel over the rays,
+ * each ray's frustum goes through the occluders' tree (small: a room's
+ * furniture) and only a ray that meets an occluder keeps a buffer (8 KiB
+ * at most). The splats then go as without masks, part by part, the same
+ * traversal and weights, each feasible batch of a ray with a buffer
+ * filtered through it (mask_ray.c): samples sum their splats in the same
+ * order, and an image without occluders is the unmasked one. A cell holds
+ * its front occluder as one 64-bit key, distance bits over the sample's
+ * index in the eye-sample tree (z >= 0: the float's bits order as the
+ * float), so z-min with the index's tie-break is one unsigned min. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
 #include <omp.h>
 
 #include "core/grow.h"
 #include "integrators/splat/mask.h"
 #include "integrators/splat/mask_ray.h"
 
-/* A kept batch: its lanes' w then (if wiz) 1 / z from val[off], packed. */
-typedef struct mask_rec {
-    uint32_t first, keep, off;
-} mask_rec;
-/* A ray's kept batches in one part: rec[rec0, rec0 + n) of a worker. */
-typedef struct mask_seg {
-    uint32_t part, rec0, n;
-} mask_seg;
-typedef struct mask_pentry {
-    uint32_t w, ray, rec0, n; /* worker, ray in the batch, its records */
-} mask_pentry;
+#define NONE UINT32_MAX
 
-/* Per thread: what one ray's traversal holds, the buffer, and the kept
- * splats of the batch's rays it took. */
+/* Per thread: the buffers of the batch's rays it took, one after another. */
 typedef struct mask_worker {
-    mask_held *held;
-    mask_feas *feas;
-    mask_rec *rec;
-    float *val;
-    mask_seg *seg;
-    uint64_t *grid; /* MASK_G^2 cells: distance bits << 32 | sample, UINT64_MAX empty */
-    uint32_t *keep; /* per feasible batch its lanes the mask keeps */
-    uint32_t capk, nh, caph, nf, capf, nrec, caprec, nval, capval, nseg, capseg;
+    _Alignas(64) uint64_t *cells; /* a cache line of its own: the threads write theirs all the time */
+    uint32_t ncell, capcell;
     int oom;
+    mask_ray x;   /* the ray being rasterized */
+    uint32_t off; /* its buffer in cells, NONE until an occluder needs one */
+    uint64_t rasterized, tested;
 } mask_worker;
 
 struct splat_mask {
     uint32_t first;     /* the batch's first ray */
-    int wiz;            /* 1 / z kept too (the occlusion test or the bandwidth AOV reads it) */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
-    float *pw;          /* per eye sample (tree order) its footprint, contiguous for the leaf loops */
-    float *ax[6];       /* and the semi-axes of the surface patch it stands for (see prepare) */
+    float *pw;          /* per eye sample (tree order) its footprint */
     uint32_t npw;
     float scale;        /* the largest coordinate of the samples' box */
+    /* the occluders under their own tree, and in its order: footprint,
+     * patch semi-axes, index in the eye-sample tree, sides */
+    cdl_skd occ;
+    float *opw, *oax[6];
+    uint32_t *oid;
+    uint8_t *oside;
+    uint32_t nocc;
     mask_worker *w;
     int nw;
-    uint32_t *rth;      /* per ray of the batch: the worker that took it, */
-    uint32_t *rseg0, *rnseg; /* its segments */
-    uint32_t *pstart, *pcur, npart; /* per part: its entries in plist, in ray order */
-    mask_pentry *plist;
-    uint32_t cappl;
+    uint32_t *roff, *rw; /* per ray of the batch: its buffer's offset (NONE: none) and worker */
+    uint8_t *rg;         /* and side in cells */
 };
 
 uint32_t splat_mask_batch(const splat_state *s)
 {
-    return s->occl || s->want_bw ? SPLAT_MASK_BATCH / 2 : SPLAT_MASK_BATCH;
+    (void)s;
+    return SPLAT_MASK_BATCH;
 }
 
 int splat_mask_alloc(splat_state *s, cdl_error *err)
@@ -111,24 +89,26 @@ int splat_mask_alloc(splat_state *s, cdl_error *err)
         return 0;
     splat_mask *m = s->mask = calloc(1, sizeof *m);
     if (m) {
-        m->rth = malloc(sizeof *m->rth * SPLAT_MASK_BATCH);
-        m->rseg0 = malloc(sizeof *m->rseg0 * SPLAT_MASK_BATCH);
-        m->rnseg = malloc(sizeof *m->rnseg * SPLAT_MASK_BATCH);
+        m->roff = malloc(sizeof *m->roff * SPLAT_MASK_BATCH);
+        m->rw = malloc(sizeof *m->rw * SPLAT_MASK_BATCH);
+        m->rg = malloc(SPLAT_MASK_BATCH);
     }
-    if (!m || !m->rth || !m->rseg0 || !m->rnseg)
+    if (!m || !m->roff || !m->rw || !m->rg)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the visibility masks");
     return 0;
 }
 
-static void worker_free(mask_worker *w)
+static void occ_free(splat_mask *m)
 {
-    free(w->held);
-    free(w->feas);
-    free(w->rec);
-    free(w->val);
-    free(w->seg);
-    free(w->grid);
-    free(w->keep);
+    cdl_skd_free(&m->occ);
+    free(m->opw);
+    for (int c = 0; c < 6; c++)
+        free(m->oax[c]);
+    free(m->oid);
+    free(m->oside);
+    m->opw = NULL, m->oid = NULL, m->oside = NULL;
+    memset(m->oax, 0, sizeof m->oax);
+    m->nocc = 0;
 }
 
 void splat_mask_free(splat_state *s)
@@ -137,17 +117,13 @@ void splat_mask_free(splat_state *s)
     if (!m)
         return;
     for (int i = 0; i < m->nw; i++)
-        worker_free(&m->w[i]);
+        free(m->w[i].cells);
     free(m->w);
-    free(m->rth);
-    free(m->rseg0);
-    free(m->rnseg);
-    free(m->pstart);
-    free(m->pcur);
-    free(m->plist);
+    free(m->roff);
+    free(m->rw);
+    free(m->rg);
     free(m->pw);
-    for (int c = 0; c < 6; c++)
-        free(m->ax[c]);
+    occ_free(m);
     free(m);
     s->mask = NULL;
 }
@@ -157,14 +133,10 @@ size_t splat_mask_bytes(const splat_state *s)
     const splat_mask *m = s->mask;
     if (!m)
         return 0;
-    size_t b = (size_t)SPLAT_MASK_BATCH * 12 + 7 * sizeof(float) * (size_t)m->npw +
-               (size_t)m->cappl * sizeof(mask_pentry) + (size_t)(2 * m->npart + 1) * sizeof(uint32_t);
-    for (int i = 0; i < m->nw; i++) {
-        const mask_worker *w = &m->w[i];
-        b += (size_t)w->caph * sizeof(mask_held) + (size_t)w->capf * sizeof(mask_feas) +
-             (size_t)w->caprec * sizeof(mask_rec) + (size_t)w->capval * sizeof(float) +
-             (size_t)w->capseg * sizeof(mask_seg) + (size_t)w->capk * sizeof(uint32_t) + (w->grid ? MASK_G * MASK_G * sizeof(uint64_t) : 0);
-    }
+    size_t b = (size_t)SPLAT_MASK_BATCH * 9 + sizeof(float) * (size_t)m->npw + cdl_skd_bytes(&m->occ) +
+               (size_t)m->nocc * (7 * sizeof(float) + sizeof(uint32_t) + 1);
+    for (int i = 0; i < m->nw; i++)
+        b += (size_t)m->w[i].capcell * sizeof(uint64_t);
     return b;
 }
 
@@ -174,25 +146,235 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Points (eye samples in tree order, or ray origins in Morton order) with
+ * a margin each (a footprint, or none) under boxes of 64 and of 64 of
+ * those, for the search of points behind a plane. */
+#define SBOX 64
+typedef struct sbox {
+    float lo[3], hi[3], pmin;
+} sbox;
+
+typedef struct pset {
+    const float *x[3], *pw; /* pw NULL: no margin */
+    uint32_t n, nf, nc;
+    sbox *fine, *coarse;
+} pset;
+
+static sbox sbox_empty(void) { return (sbox){{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}, INFINITY}; }
+
+static void sbox_add(sbox *b, const sbox *c)
+{
+    for (int a = 0; a < 3; a++)
+        b->lo[a] = fminf(b->lo[a], c->lo[a]), b->hi[a] = fmaxf(b->hi[a], c->hi[a]);
+    b->pmin = fminf(b->pmin, c->pmin);
+}
+
+static int pset_init(pset *ps)
+{
+    ps->nf = (ps->n + SBOX - 1) / SBOX, ps->nc = (ps->nf + SBOX - 1) / SBOX;
+    ps->fine = malloc(sizeof *ps->fine * (ps->nf ? ps->nf : 1));
+    ps->coarse = malloc(sizeof *ps->coarse * (ps->nc ? ps->nc : 1));
+    if (!ps->fine || !ps->coarse)
+        return -1;
+#pragma omp parallel for schedule(static)
+    for (uint32_t f = 0; f < ps->nf; f++) {
+        sbox b = sbox_empty();
+        for (uint32_t y = f * SBOX; y < ps->n && y < (f + 1) * SBOX; y++) {
+            for (int a = 0; a < 3; a++)
+                b.lo[a] = fminf(b.lo[a], ps->x[a][y]), b.hi[a] = fmaxf(b.hi[a], ps->x[a][y]);
+            b.pmin = fminf(b.pmin, ps->pw ? ps->pw[y] : 0.0f);
+        }
+        ps->fine[f] = b;
+    }
+    for (uint32_t G = 0; G < ps->nc; G++) {
+        ps->coarse[G] = sbox_empty();
+        for (uint32_t f = G * SBOX; f < ps->nf && f < (G + 1) * SBOX; f++)
+            sbox_add(&ps->coarse[G], &ps->fine[f]);
+    }
+    return 0;
+}
+
+static void pset_free(pset *ps)
+{
+    free(ps->fine);
+    free(ps->coarse);
+}
+
+/* The least p . n + pw over the box (a lower bound of its points'). */
+static inline float sbox_low(const sbox *b, const float n[3])
+{
+    float v = b->pmin;
+    for (int a = 0; a < 3; a++)
+        v += n[a] * (n[a] > 0.0f ? b->lo[a] : b->hi[a]);
+    return v;
+}
+
+/* The least p . n + pw of box f's points. */
+static float fine_min(const pset *ps, uint32_t f, const float n[3])
+{
+    const uint32_t lo = f * SBOX, hi = (f + 1) * SBOX < ps->n ? (f + 1) * SBOX : ps->n;
+    float v = INFINITY;
+#pragma omp simd reduction(min : v)
+    for (uint32_t y = lo; y < hi; y++)
+        v = fminf(v, ps->x[0][y] * n[0] + ps->x[1][y] * n[1] + ps->x[2][y] * n[2] + (ps->pw ? ps->pw[y] : 0.0f));
+    return v;
+}
+
+/* The least p . n + pw of all points (branch and bound over the boxes,
+ * the most promising group first). */
+static float pset_min(const pset *ps, const float n[3])
+{
+    float best = INFINITY;
+    uint32_t G0 = 0;
+    float l0 = INFINITY;
+    for (uint32_t G = 0; G < ps->nc; G++) {
+        float l = sbox_low(&ps->coarse[G], n);
+        if (l < l0)
+            l0 = l, G0 = G;
+    }
+    for (uint32_t i = 0; i < ps->nc; i++) {
+        uint32_t G = i == 0 ? G0 : i == G0 ? 0 : i;
+        if (!(sbox_low(&ps->coarse[G], n) < best))
+            continue;
+        for (uint32_t f = G * SBOX; f < ps->nf && f < (G + 1) * SBOX; f++)
+            if (sbox_low(&ps->fine[f], n) < best)
+                best = fminf(best, fine_min(ps, f, n));
+    }
+    return best;
+}
+
+/* Per thread, the least p . n + pw of the samples and origins for the last
+ * normals met (a planar surface's samples share theirs), +-n each. */
+#define NCACHE 64
+typedef struct ncache {
+    float n[3], v[4];
+} ncache;
+
+static const float *extremes(ncache *c, const pset *eye, const pset *org, const float n[3])
+{
+    uint32_t b[3];
+    memcpy(b, n, sizeof b);
+    ncache *e = &c[(b[0] * 73856093u ^ b[1] * 19349663u ^ b[2] * 83492791u) % NCACHE];
+    if (memcmp(e->n, n, sizeof e->n)) {
+        const float m[3] = {-n[0], -n[1], -n[2]};
+        memcpy(e->n, n, sizeof e->n);
+        e->v[0] = pset_min(eye, n), e->v[1] = pset_min(eye, m);
+        e->v[2] = pset_min(org, n), e->v[3] = pset_min(org, m);
+    }
+    return e->v;
+}
+
+/* The occluders of this pass (see the top) and their tree; 0 or an error
+ * code. */
+static int occluders(splat_state *s)
+{
+    splat_mask *m = s->mask;
+    const cdl_skd *t = &s->tree;
+    occ_free(m);
+    const uint32_t n = t->n, no = s->rays.n;
+    pset eye = {{t->p[0], t->p[1], t->p[2]}, m->pw, n, 0, 0, NULL, NULL}, org;
+    float *ox = malloc(sizeof(float) * 3 * (no ? no : 1));
+    org = (pset){{ox, ox + no, ox + 2 * (size_t)no}, NULL, no, 0, 0, NULL, NULL};
+    uint8_t *side = malloc(n ? n : 1);
+    if (ox)
+        for (uint32_t k = 0; k < no; k++)
+            ox[k] = s->rays.r[k].o.x, ox[no + k] = s->rays.r[k].o.y, ox[2 * (size_t)no + k] = s->rays.r[k].o.z;
+    if (!ox || !side || pset_init(&eye) || pset_init(&org)) {
+        pset_free(&eye), pset_free(&org), free(ox), free(side);
+        return CDL_ERR_SYSTEM;
+    }
+    /* rounding of plane offsets at the coordinates' scale: more occluders,
+     * never fewer */
+    const float eps = 1e-5f * m->scale;
+    uint32_t nocc = 0;
+#pragma omp parallel reduction(+ : nocc)
+    {
+        ncache cache[NCACHE];
+        for (int i = 0; i < NCACHE; i++)
+            cache[i].n[0] = cache[i].n[1] = cache[i].n[2] = NAN; /* matches no normal bit for bit */
+#pragma omp for schedule(dynamic, 256)
+        for (uint32_t q = 0; q < n; q++) {
+            const float nv[3] = {t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]};
+            const float c = t->p[0][q] * nv[0] + t->p[1][q] * nv[1] + t->p[2][q] * nv[2], pq = m->pw[q];
+            const float *v = extremes(cache, &eye, &org, nv);
+            /* in front: an origin with o . n > c + pq and a sample with
+             * p . n + pw < c; behind: the same with n turned */
+            uint8_t sd = 0;
+            if (v[3] < eps - c - pq && v[0] < c + eps)
+                sd |= 1u;
+            if (v[2] < c - pq + eps && v[1] < eps - c)
+                sd |= 2u;
+            side[q] = sd;
+            nocc += sd != 0;
+        }
+    }
+    pset_free(&eye);
+    pset_free(&org);
+    free(ox);
+    int rc = 0;
+    cdl_vec3 *op = malloc(sizeof *op * (nocc ? nocc : 1)), *on = malloc(sizeof *on * (nocc ? nocc : 1));
+    uint8_t *ofl = malloc(nocc ? nocc : 1);
+    uint32_t *idx = malloc(sizeof *idx * (nocc ? nocc : 1));
+    if (!op || !on || !ofl || !idx)
+        rc = CDL_ERR_SYSTEM;
+    for (uint32_t q = 0, j = 0; !rc && q < n; q++)
+        if (side[q]) {
+            op[j] = cdl_v3(t->p[0][q], t->p[1][q], t->p[2][q]);
+            on[j] = cdl_v3(t->nrm[0][q], t->nrm[1][q], t->nrm[2][q]);
+            ofl[j] = t->two[q] != 0.0f ? CDL_SKD_TWO_SIDED : 0;
+            idx[j++] = q;
+        }
+    cdl_skd_params kp = s->kp;
+    kp.cull_deg = -1.0f; /* the frustum's samples, any facing */
+    cdl_error err;
+    if (!rc && nocc && cdl_skd_build(&m->occ, op, on, ofl, nocc, &kp, &err))
+        rc = err.code;
+    if (!rc && nocc) {
+        int ok = (m->opw = malloc(sizeof(float) * (nocc + 16))) && (m->oid = calloc(nocc + 16, sizeof(uint32_t))) &&
+                 (m->oside = calloc(nocc + 16, 1));
+        for (int c = 0; c < 6; c++)
+            ok = ok && (m->oax[c] = malloc(sizeof(float) * (nocc + 16)));
+        if (!ok)
+            rc = CDL_ERR_SYSTEM;
+    }
+    if (!rc && nocc) {
+        m->nocc = nocc;
+        for (uint32_t j = 0; j < nocc; j++) {
+            uint32_t q = idx[m->occ.order[j]];
+            m->oid[j] = q;
+            m->oside[j] = side[q];
+            m->opw[j] = m->pw[q];
+        }
+        for (uint32_t j = nocc; j < nocc + 16; j++)
+            m->opw[j] = 0.0f;
+    }
+    free(op), free(on), free(ofl), free(idx), free(side);
+    return rc;
+}
+
 int splat_mask_prepare(splat_state *s)
 {
     /* cells finer than the samples' spacing only cost clearing and
      * rasterizing: the median footprint of a strided subset bounds them */
     splat_mask *m = s->mask;
-    if (m->npw < s->tree.n) {
+    if (m->npw < s->tree.n || !m->pw) {
         /* 16 lanes of padding: the leaf loops read whole batches */
         m->npw = 0;
         free(m->pw);
-        m->pw = calloc((size_t)s->tree.n + 16, sizeof *m->pw);
-        int ok = m->pw != NULL;
-        for (int c = 0; c < 6; c++) {
-            free(m->ax[c]);
-            ok &= (m->ax[c] = calloc((size_t)s->tree.n + 16, sizeof *m->ax[c])) != NULL;
-        }
-        if (!ok)
+        if (!(m->pw = calloc((size_t)s->tree.n + 16, sizeof *m->pw)))
             return CDL_ERR_SYSTEM;
         m->npw = s->tree.n;
     }
+#pragma omp parallel for schedule(static)
+    for (uint32_t q = 0; q < s->tree.n; q++)
+        m->pw[q] = s->eye[q].pw;
+    m->scale = 0.0f;
+    for (int a = 0; a < 3; a++)
+        m->scale = fmaxf(m->scale, fmaxf(fabsf(s->tree.bmin[a]), fabsf(s->tree.bmax[a])));
+    int rc = occluders(s);
+    if (rc)
+        return rc;
+    s->st.mask_occ += m->nocc;
     /* a sample stands for the patch a pixel covers: a disc of radius
      * 0.6 pw across its view ray, landed on the surface: an ellipse whose
      * axis along the view is 1 / cos longer, at most 5x: a grazing
@@ -201,19 +383,18 @@ int splat_mask_prepare(splat_state *s)
      * plate seen edge-on, but doubled the Cornell box's direct-light
      * error) */
 #pragma omp parallel for schedule(static)
-    for (uint32_t q = 0; q < s->tree.n; q++) {
-        const splat_eye *e = &s->eye[q];
+    for (uint32_t j = 0; j < m->nocc; j++) {
+        const splat_eye *e = &s->eye[m->oid[j]];
         float r = 0.6f * e->pw, c = fabsf(cdl_dot(e->wo, e->f.n));
         float r2 = r / (c > 0.2f ? c : 0.2f);
-        m->pw[q] = e->pw;
-        m->ax[0][q] = r2 * e->f.t.x, m->ax[1][q] = r2 * e->f.t.y, m->ax[2][q] = r2 * e->f.t.z;
-        m->ax[3][q] = r * e->f.b.x, m->ax[4][q] = r * e->f.b.y, m->ax[5][q] = r * e->f.b.z;
+        m->oax[0][j] = r2 * e->f.t.x, m->oax[1][j] = r2 * e->f.t.y, m->oax[2][j] = r2 * e->f.t.z;
+        m->oax[3][j] = r * e->f.b.x, m->oax[4][j] = r * e->f.b.y, m->oax[5][j] = r * e->f.b.z;
     }
+    for (int c = 0; c < 6; c++)
+        for (uint32_t j = m->nocc; m->nocc && j < m->nocc + 16; j++)
+            m->oax[c][j] = 0.0f;
     uint32_t n = s->tree.n < 4096 ? s->tree.n : 4096, step = n ? s->tree.n / n : 1;
     float *f = malloc(sizeof *f * (n ? n : 1));
-    m->scale = 0.0f;
-    for (int a = 0; a < 3; a++)
-        m->scale = fmaxf(m->scale, fmaxf(fabsf(s->tree.bmin[a]), fabsf(s->tree.bmax[a])));
     m->rho = 0.0f; /* without memory: the full grid */
     if (!f)
         return 0;
@@ -225,282 +406,140 @@ int splat_mask_prepare(splat_state *s)
     return 0;
 }
 
-/* The traversal's batches: the frustum's (occluders) and the feasible
- * ones, held until the ray's buffer is known. */
-static void collect(void *ctx, uint32_t first, uint32_t m, uint32_t any, const float *z, uint32_t feasible,
-                    const float *w, const float *iz)
+/* The buffer's side for ray r: MASK_G cells, fewer where the cone's widest
+ * cross-section holds fewer median footprints; 0: no cone. */
+static int cells_of(const splat_mask *m, const cdl_photon_ray *r)
 {
-    (void)m;
+    float hmax = r->h0 + r->dh * r->len;
+    if (!(hmax > 0.0f))
+        return 0;
+    int g = MASK_G;
+    if (2.0f * hmax < (float)g * m->rho)
+        g = (int)ceilf(2.0f * hmax / m->rho);
+    return g < 1 ? 1 : g;
+}
+
+static void ray_frame(const splat_state *s, const cdl_photon_ray *r, int g, mask_ray *x)
+{
+    const splat_mask *m = s->mask;
+    cdl_frame f = cdl_frame_from(r->d);
+    float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
+    *x = (mask_ray){&m->occ, r, m->opw, (const float *const *)m->oax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
+                    /* ~10x the rounding of a plane offset at the coordinates' scale */
+                    1e-5f * big, g, INT32_MAX, NULL, 0, m->oid, m->oside,
+                    &s->tree, m->pw};
+}
+
+/* The occluders' tree hands the frustum's batches: into the ray's buffer,
+ * made at the first. */
+static void rasterize(void *ctx, uint32_t first, uint32_t mlen, uint32_t any, const float *z, uint32_t feasible,
+                      const float *w, const float *iz)
+{
+    (void)mlen, (void)feasible, (void)w, (void)iz;
     mask_worker *x = ctx;
-    if (any) {
-        if (cdl_grow((void **)&x->held, &x->caph, x->nh + 1, sizeof *x->held)) {
+    if (!any || x->oom)
+        return;
+    x->tested += (uint64_t)__builtin_popcount(any);
+    if (x->off == NONE) {
+        const uint32_t gg = (uint32_t)(x->x.g * x->x.g);
+        if (cdl_grow((void **)&x->cells, &x->capcell, x->ncell + gg, sizeof *x->cells)) {
             x->oom = 1;
             return;
         }
-        mask_held *e = &x->held[x->nh++];
-        e->first = first;
-        e->mask = any;
-        memcpy(e->z, z, sizeof e->z);
+        x->off = x->ncell;
+        x->ncell += gg;
+        memset(x->cells + x->off, 0xff, sizeof *x->cells * gg);
     }
-    if (feasible) {
-        if (cdl_grow((void **)&x->feas, &x->capf, x->nf + 1, sizeof *x->feas)) {
-            x->oom = 1;
-            return;
-        }
-        mask_feas *e = &x->feas[x->nf++];
-        e->first = first;
-        e->mask = feasible;
-        memcpy(e->w, w, sizeof e->w);
-        memcpy(e->iz, iz, sizeof e->iz);
-    }
+    x->x.grid = x->cells + x->off;
+    x->rasterized += splat_mask_rasterize_z(&x->x, first, any, z);
 }
 
-/* Packs the kept lanes of x at val (popcount(keep) floats). */
-static inline void pack(float *val, uint32_t keep, const float *x)
-{
-#if defined(__AVX512F__)
-    const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
-    _mm512_mask_storeu_ps(val, lo, _mm512_maskz_compress_ps((__mmask16)keep, _mm512_loadu_ps(x)));
-#else
-    for (uint32_t j = 0; keep; keep &= keep - 1, j++)
-        val[j] = x[__builtin_ctz(keep)];
-#endif
-}
-
-/* The inverse: 16 lanes, 0 where not kept. */
-static inline void unpack(const float *val, uint32_t keep, float *x)
-{
-#if defined(__AVX512F__)
-    const __mmask16 lo = (__mmask16)((1u << __builtin_popcount(keep)) - 1u);
-    _mm512_storeu_ps(x, _mm512_maskz_expand_ps((__mmask16)keep, _mm512_maskz_loadu_ps(lo, val)));
-#else
-    for (uint32_t i = 0, j = 0; i < 16; i++) {
-        int in = (int)(keep >> i & 1u);
-        x[i] = in ? val[j] : 0.0f;
-        j += (uint32_t)in;
-    }
-#endif
-}
-
-typedef struct build_count {
-    uint64_t tested, weighed, nodes, rasterized, masks, buffers, masked;
-} build_count;
-
-/* Ray k of the batch on worker wid: one traversal, its mask if the
- * frustum holds more than one plane, and its surviving splats kept. */
-static void build_ray(splat_state *s, uint32_t wid, uint32_t k, int flags, build_count *bc)
+/* Ray k of the batch on worker wid: its occluders into its buffer, kept
+ * if any was rasterized. */
+static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
 {
     splat_mask *m = s->mask;
     mask_worker *x = &m->w[wid];
     const cdl_photon_ray *r = &s->rays.r[m->first + k];
+    m->roff[k] = NONE;
+    int g = cells_of(m, r);
+    if (!g || !m->nocc || x->oom)
+        return;
+    ray_frame(s, r, g, &x->x);
+    x->off = NONE;
+    uint64_t before = x->rasterized;
     cdl_splat_ray sr = splat_ray_of(s, r);
     cdl_skd_count cnt = {0, 0, 0};
-    x->nh = x->nf = 0;
-    cdl_skd_splat_visit_both(&s->tree, &sr, flags, collect, x, &cnt);
-    bc->tested += cnt.tested;
-    bc->weighed += cnt.weighed;
-    bc->nodes += cnt.nodes;
-    m->rth[k] = wid;
-    m->rseg0[k] = x->nseg;
-    m->rnseg[k] = 0;
-    if (x->oom)
+    cdl_skd_splat_visit_both(&m->occ, &sr, CDL_SKD_ANY, rasterize, x, &cnt);
+    if (x->off == NONE)
         return;
-    cdl_frame f = cdl_frame_from(r->d);
-    float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
-    mask_ray mr = {&s->tree, r, m->pw, (const float *const *)m->ax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
-                   /* ~10x the rounding of a plane offset at the coordinates' scale */
-                   1e-5f * big, 0, INT32_MIN, x->grid, 0};
-    float hmax = r->h0 + r->dh * r->len;
-    /* a mask if the frustum holds more than one plane, a buffer if one
-     * of them may hide a feasible sample */
-    if (cdl_grow((void **)&x->keep, &x->capk, x->nf, sizeof *x->keep)) {
-        x->oom = 1;
+    if (x->rasterized == before || x->oom) { /* nothing hides: no buffer */
+        x->ncell = x->off;
         return;
     }
-    uint32_t *keep = x->keep;
-    for (uint32_t j = 0; j < x->nf; j++)
-        keep[j] = x->feas[j].mask;
-    if (hmax > 0.0f && x->nf && !splat_mask_one_plane(&mr, x->held, x->nh)) {
-        bc->masks++;
-        splat_mask_reach(&mr, x->feas, x->nf);
-        if (splat_mask_hiders(&mr, x->held, x->nh, x->feas, x->nf)) {
-            bc->buffers++;
-            int g = MASK_G;
-            if (2.0f * hmax < (float)g * m->rho)
-                g = (int)ceilf(2.0f * hmax / m->rho);
-            mr.g = g < 1 ? 1 : g;
-            for (int c = 0; c < mr.g * mr.g; c++)
-                x->grid[c] = UINT64_MAX;
-            /* the hiders first: a sample no hider's front sample hides
-             * is kept whatever the others add (they hide nothing and
-             * only stand in front of hiders) */
-            for (uint32_t b = 0; b < x->nh; b++)
-                if (x->held[b].hide)
-                    bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].hide);
-            uint32_t cand = 0, front = 0;
-            for (uint32_t j = 0; j < x->nf; j++)
-                cand |= x->feas[j].mask & ~(keep[j] = splat_mask_filter(&mr, &x->feas[j], &front));
-            if (cand) {
-                /* the buffer as it would be where a sample may stand in
-                 * front of a hider that hides one (its key no larger), the
-                 * candidates filtered again */
-                if ((int32_t)front >= 0 && (int32_t)front < mr.reach)
-                    mr.reach = (int32_t)front + 1;
-                for (uint32_t b = 0; b < x->nh; b++)
-                    if (x->held[b].mask & ~x->held[b].hide)
-                        bc->rasterized += splat_mask_rasterize_lanes(&mr, &x->held[b], x->held[b].mask & ~x->held[b].hide);
-                for (uint32_t j = 0; j < x->nf; j++)
-                    if (keep[j] != x->feas[j].mask)
-                        keep[j] = splat_mask_filter(&mr, &x->feas[j], &front);
-            }
-        }
-    }
-    const cdl_skd_part *parts = s->tree.parts;
-    const uint32_t np = s->tree.nparts;
-    uint32_t p = 0, cur = UINT32_MAX;
-    for (uint32_t j = 0; j < x->nf; j++) {
-        const mask_feas *fb = &x->feas[j];
-        const uint32_t kj = keep[j];
-        bc->masked += (uint64_t)__builtin_popcount(fb->mask & ~kj);
-        if (!kj)
-            continue;
-        while (p + 1 < np && fb->first >= parts[p].hi)
-            p++;
-        uint32_t nk = (uint32_t)__builtin_popcount(kj), nv = m->wiz ? 2 * nk : nk;
-        if (cdl_grow((void **)&x->rec, &x->caprec, x->nrec + 1, sizeof *x->rec) ||
-            cdl_grow((void **)&x->val, &x->capval, x->nval + nv, sizeof *x->val)) {
-            x->oom = 1;
-            return;
-        }
-        if (cur == UINT32_MAX || x->seg[cur].part != p) {
-            if (cdl_grow((void **)&x->seg, &x->capseg, x->nseg + 1, sizeof *x->seg)) {
-                x->oom = 1;
-                return;
-            }
-            cur = x->nseg++;
-            x->seg[cur] = (mask_seg){p, x->nrec, 0};
-            m->rnseg[k]++;
-        }
-        x->rec[x->nrec++] = (mask_rec){fb->first, kj, x->nval};
-        pack(x->val + x->nval, kj, fb->w);
-        if (m->wiz)
-            pack(x->val + x->nval + nk, kj, fb->iz);
-        x->nval += nv;
-        x->seg[cur].n++;
-    }
+    m->roff[k] = x->off;
+    m->rw[k] = wid;
+    m->rg[k] = (uint8_t)g;
 }
 
-/* Workers for every thread, each with its buffer; their kept splats
- * emptied for a new batch. */
+/* Workers for every thread, their buffers emptied for a new batch. */
 static int workers(splat_mask *m)
 {
     int nth = omp_get_max_threads();
     if (nth > m->nw) {
-        mask_worker *w = realloc(m->w, sizeof *w * (size_t)nth);
+        mask_worker *w = aligned_alloc(64, sizeof *w * (size_t)nth); /* sizeof is a multiple of 64 */
         if (!w)
             return -1;
+        if (m->nw)
+            memcpy(w, m->w, sizeof *w * (size_t)m->nw);
+        free(m->w);
         memset(w + m->nw, 0, sizeof *w * (size_t)(nth - m->nw));
         m->w = w;
         m->nw = nth;
     }
     for (int i = 0; i < m->nw; i++) {
-        mask_worker *w = &m->w[i];
-        if (!w->grid && !(w->grid = malloc(sizeof *w->grid * MASK_G * MASK_G)))
-            return -1;
-        w->nrec = w->nval = w->nseg = 0;
-        w->oom = 0;
+        m->w[i].ncell = 0;
+        m->w[i].oom = 0;
+        m->w[i].rasterized = m->w[i].tested = 0;
     }
     return 0;
 }
 
-/* Every part's entries, ray by ray (a counting sort of the segments). */
-static int by_part(splat_mask *m, uint32_t nparts, uint32_t n)
-{
-    if (m->npart < nparts || !m->pstart) {
-        free(m->pstart);
-        free(m->pcur);
-        m->pstart = malloc(sizeof *m->pstart * ((size_t)nparts + 1));
-        m->pcur = malloc(sizeof *m->pcur * ((size_t)nparts + 1));
-        m->npart = nparts;
-        if (!m->pstart || !m->pcur) {
-            m->npart = 0;
-            return -1;
-        }
-    }
-    memset(m->pcur, 0, sizeof *m->pcur * ((size_t)nparts + 1));
-    uint32_t total = 0;
-    for (uint32_t k = 0; k < n; k++) {
-        const mask_seg *sg = m->w[m->rth[k]].seg + m->rseg0[k];
-        for (uint32_t j = 0; j < m->rnseg[k]; j++)
-            m->pcur[sg[j].part]++;
-        total += m->rnseg[k];
-    }
-    if (cdl_grow((void **)&m->plist, &m->cappl, total, sizeof *m->plist))
-        return -1;
-    for (uint32_t p = 0, at = 0; p <= nparts; p++) {
-        uint32_t c = p < nparts ? m->pcur[p] : 0;
-        m->pstart[p] = m->pcur[p] = at;
-        at += c;
-    }
-    for (uint32_t k = 0; k < n; k++) {
-        const mask_seg *sg = m->w[m->rth[k]].seg + m->rseg0[k];
-        for (uint32_t j = 0; j < m->rnseg[k]; j++)
-            m->plist[m->pcur[sg[j].part]++] = (mask_pentry){m->rth[k], k, sg[j].rec0, sg[j].n};
-    }
-    return 0;
-}
-
-int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags)
+int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
 {
     splat_mask *m = s->mask;
     m->first = first;
-    m->wiz = splat_mask_batch(s) < SPLAT_MASK_BATCH;
     if (workers(m))
         return CDL_ERR_SYSTEM;
-    build_count bc = {0, 0, 0, 0, 0, 0, 0};
 #pragma omp parallel
     {
-        build_count c = {0, 0, 0, 0, 0, 0, 0};
         uint32_t wid = (uint32_t)omp_get_thread_num();
 #pragma omp for schedule(dynamic, 16)
         for (uint32_t k = 0; k < n; k++)
-            build_ray(s, wid, k, flags, &c);
-#pragma omp critical
-        {
-            bc.tested += c.tested, bc.weighed += c.weighed, bc.nodes += c.nodes;
-            bc.rasterized += c.rasterized, bc.masks += c.masks, bc.buffers += c.buffers, bc.masked += c.masked;
-        }
+            build_ray(s, wid, k);
     }
-    for (int i = 0; i < m->nw; i++)
+    for (int i = 0; i < m->nw; i++) {
         if (m->w[i].oom)
             return CDL_ERR_SYSTEM;
-    if (by_part(m, s->tree.nparts, n))
-        return CDL_ERR_SYSTEM;
-    s->st.mask_tested += bc.tested;
-    s->st.tested += bc.weighed;
-    s->st.nodes += bc.nodes;
-    s->st.rasterized += bc.rasterized;
-    s->st.mask_rays += bc.masks;
-    s->st.mask_buffers += bc.buffers;
-    s->st.masked += bc.masked;
+        s->st.rasterized += m->w[i].rasterized;
+        s->st.mask_tested += m->w[i].tested;
+    }
+    for (uint32_t k = 0; k < n; k++)
+        s->st.mask_buffers += m->roff[k] != NONE;
     return 0;
 }
 
-void splat_mask_replay(const splat_state *s, uint32_t part, splat_mask_fn fn, void *ctx)
+int splat_mask_has(const splat_state *s, uint32_t ray) { return s->mask->roff[ray - s->mask->first] != NONE; }
+
+int splat_mask_ray(const splat_state *s, uint32_t ray, mask_ray *x)
 {
     const splat_mask *m = s->mask;
-    if (part >= m->npart)
-        return;
-    float w[16], iz[16] = {0.0f}; /* iz stays 0 where nothing reads it */
-    for (uint32_t e = m->pstart[part]; e < m->pstart[part + 1]; e++) {
-        const mask_pentry *pe = &m->plist[e];
-        const mask_worker *x = &m->w[pe->w];
-        for (uint32_t j = pe->rec0; j < pe->rec0 + pe->n; j++) {
-            const mask_rec *rc = &x->rec[j];
-            unpack(x->val + rc->off, rc->keep, w);
-            if (m->wiz)
-                unpack(x->val + rc->off + (uint32_t)__builtin_popcount(rc->keep), rc->keep, iz);
-            fn(ctx, m->first + pe->ray, rc->first, rc->keep, w, iz);
-        }
-    }
+    const uint32_t k = ray - m->first;
+    if (m->roff[k] == NONE)
+        return 0;
+    ray_frame(s, &s->rays.r[ray], m->rg[k], x);
+    x->grid = m->w[m->rw[k]].cells + m->roff[k];
+    return 1;
 }
+
+uint32_t splat_mask_occluders(const splat_state *s) { return s->mask ? s->mask->nocc : 0; }

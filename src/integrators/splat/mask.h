@@ -1,25 +1,26 @@
 #ifndef CDL_SPLAT_MASK_H
 #define CDL_SPLAT_MASK_H
 
-#include "integrators/splat/state.h"
+#include "integrators/splat/mask_ray.h"
 
-/* The visibility mask (§8.1, mask.c): a batch of rays at a time, build
- * traverses each ray once (flags: the splat traversal's), masks and
- * filters its feasible splats and keeps the survivors (0 or
- * CDL_ERR_SYSTEM); replay hands part `part` its kept splats ray by ray in
- * order, as batches of 16 lanes like a traversal's (cdl_skd_visit), the
- * ray's index first. */
+/* The visibility mask (§8.1, mask.c): prepare finds the pass's occluders
+ * (after the rays are traced); then a batch of rays at a time, build
+ * rasterizes the occluders in each ray's frustum into its buffer (0 or
+ * CDL_ERR_SYSTEM), and the splats of ray `ray` of the batch go through
+ * splat_mask_filter with the mask_ray splat_mask_ray sets up (it returns 0
+ * for a ray without a buffer: nothing hides its splats). */
 #define SPLAT_MASK_BATCH 8192u
-/* Rays a batch takes: SPLAT_MASK_BATCH, half of it where the kept splats
- * hold 1 / z too (about the same memory: 70 MiB on the Cornell box). */
 uint32_t splat_mask_batch(const splat_state *s);
 typedef struct splat_mask splat_mask;
 int splat_mask_alloc(splat_state *s, cdl_error *err);
 void splat_mask_free(splat_state *s);
 size_t splat_mask_bytes(const splat_state *s);
 int splat_mask_prepare(splat_state *s);
-int splat_mask_build(splat_state *s, uint32_t first, uint32_t n, int flags);
-typedef void (*splat_mask_fn)(void *ctx, uint32_t ray, uint32_t first, uint32_t mask, const float *w, const float *iz);
-void splat_mask_replay(const splat_state *s, uint32_t part, splat_mask_fn fn, void *ctx);
+int splat_mask_build(splat_state *s, uint32_t first, uint32_t n);
+int splat_mask_ray(const splat_state *s, uint32_t ray, mask_ray *x);
+/* Whether ray `ray` of the batch has a buffer. */
+int splat_mask_has(const splat_state *s, uint32_t ray);
+/* The eye samples that may hide others this pass. */
+uint32_t splat_mask_occluders(const splat_state *s);
 
 #endif

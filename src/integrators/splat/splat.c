@@ -564,13 +564,13 @@ static void splat_report(const void *self, cdl_stats *out)
     cdl_stats_add(out, "t_brdf", t->t_brdf);
     splat_cache_report(s, out);
     if (s->mask)
-        cdl_stats_printf(out, "splat: visibility mask: %.1f %% of the photon rays met more than one plane and got a mask, "
-               "%.1f %% had samples that may hide others and got a buffer; %.1f eye samples rasterized and %.1f "
-               "tested per photon ray, %.1f %% of the feasible splats masked\n",
-               t->rays_stored ? 100.0 * (double)t->mask_rays / (double)t->rays_stored : 0.0,
+        cdl_stats_printf(out, "splat: visibility mask: %.1f %% of the eye samples may hide others, %.1f %% of the "
+               "photon rays met one and got a buffer; %.1f occluders tested and %.1f rasterized per photon ray, "
+               "%.1f %% of the feasible splats masked\n",
+               t->samples ? 100.0 * (double)t->mask_occ / (double)t->samples : 0.0,
                t->rays_stored ? 100.0 * (double)t->mask_buffers / (double)t->rays_stored : 0.0,
-               t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
+               t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);
     if (s->occl) {
         uint64_t all = t->splats + t->masked + t->occluded;

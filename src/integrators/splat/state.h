@@ -32,8 +32,8 @@ typedef struct splat_eye {
 typedef struct splat_stats {
     double t_ray, t_light, t_build, t_solve, t_cache, t_brdf, t_filter, t_occl, t_total;
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
-    uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized, mask_rays;
-    uint64_t mask_buffers; /* mask rays that needed their buffer */
+    uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized, mask_occ;
+    uint64_t mask_buffers; /* photon rays with a visibility mask; mask_occ: occluders over the passes */
     uint64_t occluded, occl_rays; /* occlusion: splats dropped, shadow rays traced */
     size_t peak_bytes;
 } splat_stats;
