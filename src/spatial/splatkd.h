@@ -252,6 +252,16 @@ int cdl_skd_splat_visit_range(const cdl_skd *t, uint32_t part, const cdl_splat_r
  * feasible lanes. */
 uint32_t cdl_skd_weigh16(const cdl_skd *t, uint32_t b, uint32_t m, const cdl_splat_ray *r, float *w, float *iz);
 
+/* Whether some sample the frustum feeds (the leaf test: facing it,
+ * culling nodes honoured with CDL_SKD_CULL) lies behind one of np planes:
+ * p . n + pw[sample] < c. With early exit; for the visibility mask's
+ * question whether its occluders can hide anything at all. */
+typedef struct cdl_skd_plane {
+    float n[3], c;
+} cdl_skd_plane;
+int cdl_skd_any_behind(const cdl_skd *t, const cdl_splat_ray *r, int flags, const cdl_skd_plane *pl, int np,
+                       const float *pw, cdl_skd_count *cnt);
+
 /* Regions: the top-most subtrees of each part holding at most max_n
  * samples (a leaf of more counts as one), every sample in exactly one, in
  * tree order (Herzog et al. 2007, §6.3: where radiance cache records are

@@ -48,6 +48,10 @@ typedef struct trav {
     cdl_skd_visit_both fnb;    /* 16 lanes a call, frustum and feasible */
     void *ctx;
     cdl_skd_count *cnt;
+    /* cdl_skd_any_behind: the planes (np > 0), the footprints, the answer */
+    const cdl_skd_plane *pl;
+    int np, found;
+    const float *pw;
 } trav;
 
 /* test_range for a range visitor: the leaf tests of a chunk into arrays,
@@ -87,8 +91,14 @@ static void test_chunks(const trav *v, uint32_t lo, uint32_t hi)
 
 /* Samples [lo, hi); culled: under a culling node that prunes them (only
  * the both visit gets there, for the frustum's lanes). */
+static void range_behind(trav *v, uint32_t lo, uint32_t hi);
+
 static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
 {
+    if (v->np) {
+        range_behind((trav *)v, lo, hi);
+        return;
+    }
     v->cnt->tested += hi - lo;
     v->cnt->weighed += culled ? 0 : hi - lo;
     if (v->fnr) {
@@ -239,6 +249,19 @@ static int culled(const trav *v, const cdl_skd_wcull *c)
     return dv >= 0.0f && dv * dv >= c->c2;
 }
 
+/* The wide node's children whose spheres reach behind some plane of an
+ * any_behind walk. */
+static inline uint32_t wide_behind(const trav *v, const cdl_skd_wnode *w)
+{
+    uint32_t mask = 0;
+    for (int k = 0; k < v->np; k++) {
+        const float *n = v->pl[k].n, c = v->pl[k].c;
+        for (uint32_t i = 0; i < CDL_SKD_WIDTH; i++)
+            mask |= (uint32_t)(w->c[0][i] * n[0] + w->c[1][i] * n[1] + w->c[2][i] * n[2] - w->c[3][i] < c) << i;
+    }
+    return mask;
+}
+
 #define WIDE_STACK 512
 
 /* The default traversal on the wide tree from entry e (its sphere
@@ -264,6 +287,8 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
         } else if (e.n == 0) {
             const cdl_skd_wnode *w = &t->wide[e.ref];
             uint32_t hit = wide_reached(v, w);
+            if (v->np)
+                hit &= wide_behind(v, w);
             if (hit) {
                 uint32_t k = (uint32_t)__builtin_ctz(hit);
                 hit &= hit - 1;
@@ -278,7 +303,7 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
         } else if (e.n != CDL_SKD_WEMPTY) {
             test_range(v, e.ref, e.ref + e.n, cut != UINT32_MAX);
         }
-        if (!sp)
+        if (!sp || v->found)
             return;
         e = stack[--sp];
         if (sp < cut)
@@ -431,7 +456,7 @@ void cdl_skd_stop_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r,
     float hmax = radius_at(r, r->len);
     stop_trav s = {{t, r, {r->o.x, r->o.y, r->o.z}, {r->d.x, r->d.y, r->d.z}, {0.0f, 0.0f, 0.0f},
                     r->len + (r->cap > 0.0f ? r->cap : 1.0f) * hmax, (flags & CDL_SKD_CULL) != 0, 0, 0, 1, 0, NULL, NULL,
-                    NULL, NULL, cnt},
+                    NULL, NULL, cnt, NULL, 0, 0, NULL},
                    stop, fn, ctx};
     traverse_stop(&s, t->parts[part].node);
 }
@@ -465,7 +490,11 @@ static int splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, 
               fnr,
               fnb,
               ctx,
-              cnt};
+              cnt,
+              NULL,
+              0,
+              0,
+              NULL};
     for (int a = 0; a < 3; a++)
         v.inv[a] = v.d[a] != 0.0f ? 1.0f / fabsf(v.d[a]) : 0.0f;
     /* clip [0, len + cap h(len)] by the box grown by the largest radius */
@@ -497,6 +526,53 @@ static int splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, 
     else if (e.n != CDL_SKD_WEMPTY && sphere_reached(&v, root))
         traverse_wide(&v, e);
     return 0;
+}
+
+/* cdl_skd_any_behind's leaves: the samples the frustum feeds, behind a
+ * plane by more than their footprint. */
+static void range_behind(trav *v, uint32_t lo, uint32_t hi)
+{
+    const cdl_skd *t = v->t;
+    const soa16 a = soa16_of(t);
+    ray16 L;
+    ray16_of(&L, v->r);
+    v->cnt->tested += hi - lo;
+    for (uint32_t q = lo; q < hi && !v->found; q += 16) {
+        uint32_t m = hi - q < 16 ? hi - q : 16;
+        float w[16], iz[16];
+        uint32_t feas = v->r->cap > 0.0f ? weigh16(&a, q, m, &L, 1, 0, w, iz, NULL) : weigh16(&a, q, m, &L, 0, 0, w, iz, NULL);
+        for (; feas && !v->found; feas &= feas - 1) {
+            uint32_t i = q + (uint32_t)__builtin_ctz(feas);
+            for (int k = 0; k < v->np; k++)
+                if (t->p[0][i] * v->pl[k].n[0] + t->p[1][i] * v->pl[k].n[1] + t->p[2][i] * v->pl[k].n[2] + v->pw[i] <
+                    v->pl[k].c) {
+                    v->found = 1;
+                    break;
+                }
+        }
+    }
+}
+
+int cdl_skd_any_behind(const cdl_skd *t, const cdl_splat_ray *r, int flags, const cdl_skd_plane *pl, int np,
+                       const float *pw, cdl_skd_count *cnt)
+{
+    if (!t->n || np <= 0)
+        return 0;
+    trav v;
+    memset(&v, 0, sizeof v);
+    v.t = t;
+    v.r = r;
+    v.o[0] = r->o.x, v.o[1] = r->o.y, v.o[2] = r->o.z;
+    v.d[0] = r->d.x, v.d[1] = r->d.y, v.d[2] = r->d.z;
+    v.zmax = r->len + (r->cap > 0.0f ? r->cap : 1.0f) * radius_at(r, r->len);
+    v.cull = (flags & CDL_SKD_CULL) != 0;
+    v.cnt = cnt;
+    v.pl = pl, v.np = np, v.pw = pw;
+    if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack: every sample */
+        range_behind(&v, 0, t->n);
+    else if (t->wroot.n != CDL_SKD_WEMPTY && sphere_reached(&v, 0))
+        traverse_wide(&v, t->wroot);
+    return v.found;
 }
 
 int cdl_skd_splat_visit(const cdl_skd *t, uint32_t part, const cdl_splat_ray *r, int flags, cdl_skd_visit fn,

@@ -372,7 +372,7 @@ static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *m
             if (c->mk) { /* the visibility mask's filter (set up at the ray's first splat in this part) */
                 if (c->mk == 1)
                     c->mk = 1 + splat_mask_ray(c->s, c->ray, &c->mr);
-                uint32_t kept = splat_mask_filter(&c->mr, first + 16 * j, k, iz + 16 * j);
+                uint32_t kept = splat_mask_filter(&c->mr, first + 16 * j, k);
                 c->masked += (uint64_t)__builtin_popcount(k & ~kept);
                 if (!(k = kept))
                     continue;
@@ -408,7 +408,7 @@ int splat_maps_splat(splat_state *s)
     splat_maps_clear(s);
     uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0, masked = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0) |
-                      (s->mask || s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
+                      (s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
     /* with visibility masks, a batch of rays at a time: their buffers
      * first (the occluders in each frustum), then the splats through them */
     uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);

@@ -41,20 +41,32 @@
 #include <stdlib.h>
 #include <string.h>
 #include <omp.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "core/grow.h"
 #include "integrators/splat/mask.h"
 #include "integrators/splat/mask_ray.h"
 
 #define NONE UINT32_MAX
+#define PLANES 8
 
 /* Per thread: the buffers of the batch's rays it took, one after another. */
 typedef struct mask_worker {
-    _Alignas(64) uint64_t *cells; /* a cache line of its own: the threads write theirs all the time */
+    _Alignas(64) uint32_t *cells; /* the buffers, each g^2 distance bits then g^2 samples (a cache line
+                                   * of its own: the threads write theirs all the time) */
+    uint64_t *grid;               /* MASK_G^2 keys: the ray being rasterized */
     uint32_t ncell, capcell;
     int oom;
-    mask_ray x;   /* the ray being rasterized */
-    uint32_t off; /* its buffer in cells, NONE until an occluder needs one */
+    mask_ray x;   /* the ray being built */
+    mask_held *held; /* its occluders */
+    uint32_t nh, caph;
+    /* the rasterized occluders' planes, turned so that a sample one may
+     * hide has p . n + pw < c: the largest c per normal (np > PLANES: too
+     * many normals to ask) */
+    cdl_skd_plane pl[PLANES];
+    int np, last; /* last: the plane the last lane had */
     uint64_t rasterized, tested;
 } mask_worker;
 
@@ -116,8 +128,11 @@ void splat_mask_free(splat_state *s)
     splat_mask *m = s->mask;
     if (!m)
         return;
-    for (int i = 0; i < m->nw; i++)
+    for (int i = 0; i < m->nw; i++) {
         free(m->w[i].cells);
+        free(m->w[i].grid);
+        free(m->w[i].held);
+    }
     free(m->w);
     free(m->roff);
     free(m->rw);
@@ -136,7 +151,8 @@ size_t splat_mask_bytes(const splat_state *s)
     size_t b = (size_t)SPLAT_MASK_BATCH * 9 + sizeof(float) * (size_t)m->npw + cdl_skd_bytes(&m->occ) +
                (size_t)m->nocc * (7 * sizeof(float) + sizeof(uint32_t) + 1);
     for (int i = 0; i < m->nw; i++)
-        b += (size_t)m->w[i].capcell * sizeof(uint64_t);
+        b += (size_t)m->w[i].capcell * sizeof(uint32_t) + (size_t)m->w[i].caph * sizeof(mask_held) +
+             (m->w[i].grid ? sizeof(uint64_t) * MASK_G * MASK_G : 0);
     return b;
 }
 
@@ -427,35 +443,104 @@ static void ray_frame(const splat_state *s, const cdl_photon_ray *r, int g, mask
     *x = (mask_ray){&m->occ, r, m->opw, (const float *const *)m->oax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
                     /* ~10x the rounding of a plane offset at the coordinates' scale */
                     1e-5f * big, g, INT32_MAX, NULL, 0, m->oid, m->oside,
-                    &s->tree, m->pw};
+                    &s->tree, m->pw, NULL, NULL};
 }
 
-/* The occluders' tree hands the frustum's batches: into the ray's buffer,
- * made at the first. */
-static void rasterize(void *ctx, uint32_t first, uint32_t mlen, uint32_t any, const float *z, uint32_t feasible,
-                      const float *w, const float *iz)
+/* The occluders' tree hands the frustum's batches: the lanes that may
+ * hide something for this ray (not on the surface it leaves, on a side
+ * its origin may hide from) are held, and their planes noted. */
+static void collect(void *ctx, uint32_t first, uint32_t mlen, uint32_t any, const float *z, uint32_t feasible,
+                    const float *w, const float *iz)
 {
     (void)mlen, (void)feasible, (void)w, (void)iz;
     mask_worker *x = ctx;
     if (!any || x->oom)
         return;
     x->tested += (uint64_t)__builtin_popcount(any);
-    if (x->off == NONE) {
-        const uint32_t gg = (uint32_t)(x->x.g * x->x.g);
-        if (cdl_grow((void **)&x->cells, &x->capcell, x->ncell + gg, sizeof *x->cells)) {
-            x->oom = 1;
-            return;
-        }
-        x->off = x->ncell;
-        x->ncell += gg;
-        memset(x->cells + x->off, 0xff, sizeof *x->cells * gg);
+    const cdl_skd *t = x->x.t;
+    const float ox = x->x.r->o.x, oy = x->x.r->o.y, oz = x->x.r->o.z;
+    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first;
+    const float *nx = t->nrm[0] + first, *ny = t->nrm[1] + first, *nz = t->nrm[2] + first;
+    const float *pw = x->x.pw + first;
+    const uint8_t *sd = x->x.side + first;
+    /* as splat_mask_rasterize_z's (so > 0: the origin behind the plane);
+     * cc: the plane's offset turned to the hiding side */
+#if defined(__AVX512F__)
+    const __m512 vnx = _mm512_loadu_ps(nx), vny = _mm512_loadu_ps(ny), vnz = _mm512_loadu_ps(nz);
+    const __m512 vpx = _mm512_loadu_ps(px), vpy = _mm512_loadu_ps(py), vpz = _mm512_loadu_ps(pz);
+    const __m512 c = _mm512_fmadd_ps(vpz, vnz, _mm512_fmadd_ps(vpy, vny, _mm512_mul_ps(vpx, vnx)));
+    const __m512 so = _mm512_fmadd_ps(_mm512_sub_ps(vpz, _mm512_set1_ps(oz)), vnz,
+                                      _mm512_fmadd_ps(_mm512_sub_ps(vpy, _mm512_set1_ps(oy)), vny,
+                                                      _mm512_mul_ps(_mm512_sub_ps(vpx, _mm512_set1_ps(ox)), vnx)));
+    const __mmask16 pos = _mm512_cmp_ps_mask(so, _mm512_setzero_ps(), _CMP_GT_OQ);
+    const __m512 cc = _mm512_mask_sub_ps(c, pos, _mm512_setzero_ps(), c);
+    __m512i side = _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)sd));
+    side = _mm512_mask_srli_epi32(side, pos, side, 1);
+    uint32_t keep = _mm512_mask_cmp_ps_mask((__mmask16)any, _mm512_abs_ps(so), _mm512_loadu_ps(pw), _CMP_GT_OQ) &
+                    _mm512_test_epi32_mask(side, _mm512_set1_epi32(1));
+#else
+    float so[16], cc[16];
+    uint32_t keep = 0;
+    for (uint32_t i = 0; i < 16; i++) {
+        float c = px[i] * nx[i] + py[i] * ny[i] + pz[i] * nz[i];
+        so[i] = (px[i] - ox) * nx[i] + (py[i] - oy) * ny[i] + (pz[i] - oz) * nz[i];
+        cc[i] = so[i] > 0.0f ? -c : c;
+        keep |= (uint32_t)((fabsf(so[i]) > pw[i]) & ((so[i] > 0.0f ? sd[i] >> 1 : sd[i]) & 1)) << i;
     }
-    x->x.grid = x->cells + x->off;
-    x->rasterized += splat_mask_rasterize_z(&x->x, first, any, z);
+    keep &= any;
+#endif
+    if (!keep)
+        return;
+    if (cdl_grow((void **)&x->held, &x->caph, x->nh + 1, sizeof *x->held)) {
+        x->oom = 1;
+        return;
+    }
+    mask_held *h = &x->held[x->nh++];
+    h->first = first, h->mask = keep;
+    memcpy(h->z, z, sizeof h->z);
+    /* the planes, turned to the side that hides (the origin's other
+     * side): a batch's lanes mostly share one, taken all at once */
+    for (uint32_t m = keep; m && x->np <= PLANES;) {
+        uint32_t i = (uint32_t)__builtin_ctz(m);
+        const float n0x = nx[i], n0y = ny[i], n0z = nz[i];
+#if defined(__AVX512F__)
+        const int back = (int)(pos >> i & 1u);
+        const float s0 = back ? -1.0f : 1.0f;
+        __mmask16 same = _mm512_mask_cmp_ps_mask((__mmask16)m, vnx, _mm512_set1_ps(n0x), _CMP_EQ_OQ);
+        same = _mm512_mask_cmp_ps_mask(same, vny, _mm512_set1_ps(n0y), _CMP_EQ_OQ);
+        same = _mm512_mask_cmp_ps_mask(same, vnz, _mm512_set1_ps(n0z), _CMP_EQ_OQ);
+        same &= back ? pos : (__mmask16)~pos;
+        same |= (__mmask16)(1u << i); /* a NaN normal: alone */
+        float c0 = _mm512_mask_reduce_max_ps(same, cc);
+#else
+        const float s0 = so[i] > 0.0f ? -1.0f : 1.0f;
+        uint32_t same = 1u << i;
+        float c0 = cc[i];
+        for (uint32_t j = 0; j < 16; j++)
+            if ((m >> j & 1u) && nx[j] == n0x && ny[j] == n0y && nz[j] == n0z && (so[j] > 0.0f ? -1.0f : 1.0f) == s0) {
+                same |= 1u << j;
+                c0 = cc[j] > c0 ? cc[j] : c0;
+            }
+#endif
+        m &= ~(uint32_t)same;
+        const float n[3] = {s0 * n0x, s0 * n0y, s0 * n0z}, c = c0 + x->x.eps;
+        int k = x->last < x->np ? x->last : 0;
+        if (!(k < x->np && x->pl[k].n[0] == n[0] && x->pl[k].n[1] == n[1] && x->pl[k].n[2] == n[2]))
+            for (k = 0; k < x->np && !(x->pl[k].n[0] == n[0] && x->pl[k].n[1] == n[1] && x->pl[k].n[2] == n[2]); k++)
+                ;
+        if (k == x->np) {
+            if (x->np++ == PLANES)
+                break;
+            x->pl[k] = (cdl_skd_plane){{n[0], n[1], n[2]}, c};
+        } else if (c > x->pl[k].c)
+            x->pl[k].c = c;
+        x->last = k;
+    }
 }
 
-/* Ray k of the batch on worker wid: its occluders into its buffer, kept
- * if any was rasterized. */
+/* Ray k of the batch on worker wid: its occluders found; a buffer only
+ * if some sample it feeds lies behind one's plane (else nothing can be
+ * hidden), made and filled. */
 static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
 {
     splat_mask *m = s->mask;
@@ -466,20 +551,36 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
     if (!g || !m->nocc || x->oom)
         return;
     ray_frame(s, r, g, &x->x);
-    x->off = NONE;
-    uint64_t before = x->rasterized;
+    x->nh = 0;
+    x->np = 0;
+    x->last = 0;
     cdl_splat_ray sr = splat_ray_of(s, r);
     cdl_skd_count cnt = {0, 0, 0};
-    cdl_skd_splat_visit_both(&m->occ, &sr, CDL_SKD_ANY, rasterize, x, &cnt);
-    if (x->off == NONE)
+    cdl_skd_splat_visit_both(&m->occ, &sr, CDL_SKD_ANY, collect, x, &cnt);
+    if (!x->nh || x->oom ||
+        (x->np <= PLANES && !cdl_skd_any_behind(&s->tree, &sr, s->opt.splat.cull ? CDL_SKD_CULL : 0, x->pl, x->np, m->pw, &cnt)))
         return;
-    if (x->rasterized == before || x->oom) { /* nothing hides: no buffer */
-        x->ncell = x->off;
+    const uint32_t gg = (uint32_t)(g * g);
+    if (cdl_grow((void **)&x->cells, &x->capcell, x->ncell + 2 * gg, sizeof *x->cells)) {
+        x->oom = 1;
         return;
     }
-    m->roff[k] = x->off;
+    uint64_t *grid = x->grid;
+    memset(grid, 0xff, sizeof *grid * gg);
+    x->x.grid = grid;
+    for (uint32_t b = 0; b < x->nh; b++)
+        x->rasterized += (uint64_t)__builtin_popcount(splat_mask_rasterize_z(&x->x, x->held[b].first, x->held[b].mask, x->held[b].z));
+    /* split for the filter: one gather of distances, one of samples where
+     * they are near enough */
+    uint32_t *zg = x->cells + x->ncell, *ig = zg + gg;
+    for (uint32_t c = 0; c < gg; c++) {
+        zg[c] = grid[c] == UINT64_MAX ? (uint32_t)INT32_MAX : (uint32_t)(grid[c] >> 32);
+        ig[c] = (uint32_t)grid[c];
+    }
+    m->roff[k] = x->ncell;
     m->rw[k] = wid;
     m->rg[k] = (uint8_t)g;
+    x->ncell += 2 * gg;
 }
 
 /* Workers for every thread, their buffers emptied for a new batch. */
@@ -498,6 +599,8 @@ static int workers(splat_mask *m)
         m->nw = nth;
     }
     for (int i = 0; i < m->nw; i++) {
+        if (!m->w[i].grid && !(m->w[i].grid = malloc(sizeof(uint64_t) * MASK_G * MASK_G)))
+            return -1;
         m->w[i].ncell = 0;
         m->w[i].oom = 0;
         m->w[i].rasterized = m->w[i].tested = 0;
@@ -538,7 +641,8 @@ int splat_mask_ray(const splat_state *s, uint32_t ray, mask_ray *x)
     if (m->roff[k] == NONE)
         return 0;
     ray_frame(s, &s->rays.r[ray], m->rg[k], x);
-    x->grid = m->w[m->rw[k]].cells + m->roff[k];
+    x->zg = m->w[m->rw[k]].cells + m->roff[k];
+    x->ig = x->zg + (uint32_t)(x->g * x->g);
     return 1;
 }
 

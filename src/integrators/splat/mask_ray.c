@@ -25,7 +25,7 @@ static inline uint32_t float_bits(float f)
  * the filter's threshold: a front sample whose distance bits are below it
  * is nearer by more than the footprint (distances >= 0 order as their
  * bits; a negative z - pw is a negative int, below every distance). */
-static inline void cells16(const mask_ray *x, uint32_t first, const float *iz, int *cell, int32_t *zb)
+static inline void cells16(const mask_ray *x, uint32_t first, int *cell, int32_t *zb)
 {
     const cdl_skd *t = x->ft;
     const cdl_photon_ray *r = x->r;
@@ -36,8 +36,9 @@ static inline void cells16(const mask_ray *x, uint32_t first, const float *iz, i
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = x->fpw + first;
 #pragma omp simd
     for (int i = 0; i < 16; i++) {
-        float z = iz[i] > 0.0f ? 1.0f / iz[i] : 0.0f;
-        float ex = px[i] - ox - z * dx, ey = py[i] - oy - z * dy, ez = pz[i] - oz - z * dz;
+        /* z as the occluders have theirs (the traversal's) */
+        float Dx = px[i] - ox, Dy = py[i] - oy, Dz = pz[i] - oz, z = Dx * dx + Dy * dy + Dz * dz;
+        float ex = Dx - z * dx, ey = Dy - z * dy, ez = Dz - z * dz;
         float ih = ics / (h0 + dh * (z < len ? z : len));
         float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + half, v = (ex * V[0] + ey * V[1] + ez * V[2]) * ih + half;
         int in = u >= 0.0f && v >= 0.0f && u < (float)g && v < (float)g;
@@ -113,7 +114,10 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
 }
 #endif
 
-uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb) { return splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z); }
+uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
+{
+    return (uint32_t)__builtin_popcount(splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z));
+}
 
 uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz)
 {
@@ -216,7 +220,7 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
                 window8(x, first, live, box, zk, A0, B0, B1, 4);
             else
                 window8(x, first, live, box, zk, A0, B0, B1, 8);
-            return (uint32_t)__builtin_popcount(live);
+            return live;
         }
     }
 #endif
@@ -236,39 +240,31 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
             for (int a = box[0][i]; a <= box[1][i]; a++)
                 cell_min(grid + b * g + a, key);
     }
-    return (uint32_t)__builtin_popcount(small | large);
+    return small | large;
 }
 
-uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask, const float *iz)
+uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask)
 {
     const cdl_skd *t = x->ft;
-    const uint64_t *grid = x->grid;
     const float ox = x->r->o.x, oy = x->r->o.y, oz = x->r->o.z;
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = x->fpw + first;
     int cell[16];
     int32_t zb[16];
-    cells16(x, first, iz, cell, zb);
-    /* candidates: a front sample, not the lane itself, nearer by more
-     * than the lane's footprint */
+    cells16(x, first, cell, zb);
+    /* candidates: a front occluder nearer by more than the lane's
+     * footprint (so not the lane itself; an empty cell's distance bits are
+     * INT32_MAX) */
 #if defined(__AVX512F__)
-    const __m512i c = _mm512_loadu_si512(cell), none = _mm512_set1_epi64(-1);
+    const __m512i c = _mm512_loadu_si512(cell);
     const __mmask16 in = _mm512_mask_cmpge_epi32_mask((__mmask16)mask, c, _mm512_setzero_si512());
-    __m512i klo = _mm512_mask_i32gather_epi64(none, (__mmask8)in, _mm512_castsi512_si256(c), grid, 8);
-    __m512i khi = _mm512_mask_i32gather_epi64(none, (__mmask8)(in >> 8), _mm512_extracti64x4_epi64(c, 1), grid, 8);
-    /* the keys' low halves (samples) and high halves (distance bits) */
-    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-    __m512i o = _mm512_permutex2var_epi32(klo, even, khi);
-    __m512i zk = _mm512_permutex2var_epi32(klo, _mm512_add_epi32(even, _mm512_set1_epi32(1)), khi);
-    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    __mmask16 cm = _mm512_mask_cmpneq_epi32_mask(in, o, _mm512_set1_epi32(-1));
-    cm = _mm512_mask_cmpneq_epi32_mask(cm, o, _mm512_add_epi32(lane, _mm512_set1_epi32((int)first)));
-    cm = _mm512_mask_cmplt_epi32_mask(cm, zk, _mm512_loadu_si512(zb));
+    const __m512i zk = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(INT32_MAX), in, c, (const int *)x->zg, 4);
+    const __mmask16 cm = _mm512_mask_cmplt_epi32_mask(in, zk, _mm512_loadu_si512(zb));
     if (!cm)
         return mask;
+    const __m512i o = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), cm, c, (const int *)x->ig, 4);
     /* hidden if the sample lies on the far side of the occluder's
-     * tangent plane from the ray's origin (by its footprint); an occluder
-     * whose plane holds the origin (the surface the ray leaves) hides
-     * nothing */
+     * tangent plane from the ray's origin (by its footprint; the origin
+     * lies off that plane by more than the occluder's: it was rasterized) */
     const __m512 zero = _mm512_setzero_ps();
     __m512 nx = _mm512_mask_i32gather_ps(zero, cm, o, t->nrm[0], 4);
     __m512 ny = _mm512_mask_i32gather_ps(zero, cm, o, t->nrm[1], 4);
@@ -276,7 +272,6 @@ uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask, con
     __m512 qx = _mm512_mask_i32gather_ps(zero, cm, o, t->p[0], 4);
     __m512 qy = _mm512_mask_i32gather_ps(zero, cm, o, t->p[1], 4);
     __m512 qz = _mm512_mask_i32gather_ps(zero, cm, o, t->p[2], 4);
-    __m512 pwo = _mm512_mask_i32gather_ps(zero, cm, o, x->fpw, 4);
     __m512 so = _mm512_fmadd_ps(_mm512_sub_ps(_mm512_set1_ps(oz), qz), nz,
                          _mm512_fmadd_ps(_mm512_sub_ps(_mm512_set1_ps(oy), qy), ny,
                                          _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(ox), qx), nx)));
@@ -284,31 +279,25 @@ uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask, con
                                 _mm512_fmadd_ps(_mm512_sub_ps(_mm512_loadu_ps(py), qy), ny,
                                                 _mm512_mul_ps(_mm512_sub_ps(_mm512_loadu_ps(px), qx), nx)));
     __m512 rho = _mm512_loadu_ps(pw);
-    __mmask16 hide = _mm512_mask_cmp_ps_mask(cm, _mm512_abs_ps(so), pwo, _CMP_GT_OQ);
+    __mmask16 hide = cm;
     __mmask16 pos = _mm512_cmp_ps_mask(so, zero, _CMP_GT_OQ);
     hide &= (__mmask16)((pos & _mm512_cmp_ps_mask(sy, _mm512_sub_ps(zero, rho), _CMP_LT_OQ)) |
                         (~pos & _mm512_cmp_ps_mask(sy, rho, _CMP_GT_OQ)));
     return mask & ~(uint32_t)hide;
 #else
-    uint32_t hit = 0, occ[16];
-    for (int i = 0; i < 16; i++) {
-        if (!(mask >> i & 1u) || cell[i] < 0)
-            continue;
-        uint64_t key = grid[cell[i]];
-        occ[i] = (uint32_t)key;
-        hit |= (uint32_t)((occ[i] != UINT32_MAX) & (occ[i] != first + (uint32_t)i) &
-                          ((int32_t)(uint32_t)(key >> 32) < zb[i])) << i;
-    }
+    uint32_t hit = 0;
+    for (int i = 0; i < 16; i++)
+        if ((mask >> i & 1u) && cell[i] >= 0)
+            hit |= (uint32_t)((int32_t)x->zg[cell[i]] < zb[i]) << i;
     uint32_t keep = mask;
     for (; hit; hit &= hit - 1) {
-        uint32_t i = (uint32_t)__builtin_ctz(hit), o = occ[i];
+        uint32_t i = (uint32_t)__builtin_ctz(hit), o = x->ig[cell[i]];
         /* hidden if the sample lies on the far side of the occluder's
-         * tangent plane from the ray's origin; an occluder whose plane
-         * holds the origin (the surface the ray leaves) hides nothing */
+         * tangent plane from the ray's origin */
         float rho = pw[i], nx = t->nrm[0][o], ny = t->nrm[1][o], nz = t->nrm[2][o];
         float so = (ox - t->p[0][o]) * nx + (oy - t->p[1][o]) * ny + (oz - t->p[2][o]) * nz;
         float sy = (px[i] - t->p[0][o]) * nx + (py[i] - t->p[1][o]) * ny + (pz[i] - t->p[2][o]) * nz;
-        if (fabsf(so) > x->fpw[o] && (so > 0.0f ? sy < -rho : sy > rho))
+        if (so > 0.0f ? sy < -rho : sy > rho)
             keep &= ~(1u << i);
     }
     return keep;

@@ -30,14 +30,16 @@ typedef struct mask_ray {
                                   * plane, bit 1 behind), NULL: both */
     const cdl_skd *ft;           /* the feasible samples' tree, */
     const float *fpw;            /* their footprints */
+    const uint32_t *zg, *ig;     /* the filter's grid: the keys' distance bits (INT32_MAX empty), samples */
 } mask_ray;
 
 /* One held batch into x->grid; returns the samples it rasterized. */
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb);
-/* The same for occluders [first, first + 16) in lanes with distances z. */
+/* The same for occluders [first, first + 16) in lanes with distances z;
+ * returns the lanes it rasterized. */
 uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z);
-/* The lanes in mask of feasible samples [first, first + 16) (1 / z in iz)
- * the buffer does not hide. */
-uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask, const float *iz);
+/* The lanes in mask of feasible samples [first, first + 16) the buffer
+ * does not hide. */
+uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask);
 
 #endif
