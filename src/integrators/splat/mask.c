@@ -21,16 +21,17 @@
  * from some ray origin of the pass in front of it by more than its own
  * (or the same with the sides swapped). In a room the walls, floor and
  * ceiling bound everything and never can; the furniture, thin walls and
- * doors can. prepare finds them once a pass (bounds of 64 samples, then of
- * 4096, prune the search; the ray origins' box stands for the origins)
- * and puts them under a tree of their own, with the sides they may hide
- * from. A sample that can hide nothing is no occluder at all: it neither
+ * doors can. prepare finds them once a pass (boxes of 64 and of 4096
+ * samples, and of ray origins, bound the search) and puts them under a
+ * tree of their own, with the sides they may hide from. A sample that can hide nothing is no occluder at all: it neither
  * hides nor stands in front of an occluder to unveil what lies behind both.
  *
  * Cost (issue 29): a batch of rays at a time, in parallel over the rays,
  * each ray's frustum goes through the occluders' tree (small: a room's
- * furniture) and only a ray that meets an occluder keeps a buffer (8 KiB
- * at most). The splats then go as without masks, part by part, the same
+ * furniture), and a ray that meets occluders gets a buffer (8 KiB at most)
+ * only if some sample it feeds lies behind one of their planes (else
+ * nothing could be hidden: cdl_skd_any_behind, which stops at the first).
+ * The splats then go as without masks, part by part, the same
  * traversal and weights, each feasible batch of a ray with a buffer
  * filtered through it (mask_ray.c): samples sum their splats in the same
  * order, and an image without occluders is the unmasked one. A cell holds
@@ -62,7 +63,7 @@ typedef struct mask_worker {
     mask_ray x;   /* the ray being built */
     mask_held *held; /* its occluders */
     uint32_t nh, caph;
-    /* the rasterized occluders' planes, turned so that a sample one may
+    /* the held occluders' planes, turned so that a sample one may
      * hide has p . n + pw < c: the largest c per normal (np > PLANES: too
      * many normals to ask) */
     cdl_skd_plane pl[PLANES];
