@@ -95,10 +95,6 @@ static void range_behind(trav *v, uint32_t lo, uint32_t hi);
 
 static void test_range(const trav *v, uint32_t lo, uint32_t hi, int culled)
 {
-    if (v->np) {
-        range_behind((trav *)v, lo, hi);
-        return;
-    }
     v->cnt->tested += hi - lo;
     v->cnt->weighed += culled ? 0 : hi - lo;
     if (v->fnr) {
@@ -267,7 +263,12 @@ static inline uint32_t wide_behind(const trav *v, const cdl_skd_wnode *w)
 /* The default traversal on the wide tree from entry e (its sphere
  * tested), depth first with a stack: the leaves in the binary
  * traversal's order. */
-static void traverse_wide(const trav *v, cdl_skd_went e)
+/* behind: cdl_skd_any_behind's walk (a constant: the plain traversal
+ * keeps none of its tests) */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void wide_walk(const trav *v, cdl_skd_went e, const int behind)
 {
     const cdl_skd *t = v->t;
     cdl_skd_went stack[WIDE_STACK];
@@ -287,7 +288,7 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
         } else if (e.n == 0) {
             const cdl_skd_wnode *w = &t->wide[e.ref];
             uint32_t hit = wide_reached(v, w);
-            if (v->np)
+            if (behind)
                 hit &= wide_behind(v, w);
             if (hit) {
                 uint32_t k = (uint32_t)__builtin_ctz(hit);
@@ -301,15 +302,22 @@ static void traverse_wide(const trav *v, cdl_skd_went e)
                 continue;
             }
         } else if (e.n != CDL_SKD_WEMPTY) {
-            test_range(v, e.ref, e.ref + e.n, cut != UINT32_MAX);
+            if (behind)
+                range_behind((trav *)v, e.ref, e.ref + e.n);
+            else
+                test_range(v, e.ref, e.ref + e.n, cut != UINT32_MAX);
         }
-        if (!sp || v->found)
+        if (!sp || (behind && v->found))
             return;
         e = stack[--sp];
         if (sp < cut)
             cut = UINT32_MAX;
     }
 }
+
+static void traverse_wide(const trav *v, cdl_skd_went e) { wide_walk(v, e, 0); }
+
+static void traverse_behind(trav *v, cdl_skd_went e) { wide_walk(v, e, 1); }
 
 /* Algorithm 1: node over the ray interval [t0, t1]. */
 static void traverse(const trav *v, uint32_t node, float t0, float t1, int culled)
@@ -571,7 +579,7 @@ int cdl_skd_any_behind(const cdl_skd *t, const cdl_splat_ray *r, int flags, cons
     if ((uint64_t)(CDL_SKD_WIDTH - 1) * (t->depth + 3) >= WIDE_STACK) /* deeper than the stack: every sample */
         range_behind(&v, 0, t->n);
     else if (t->wroot.n != CDL_SKD_WEMPTY && sphere_reached(&v, 0))
-        traverse_wide(&v, t->wroot);
+        traverse_behind(&v, t->wroot);
     return v.found;
 }
 

@@ -363,13 +363,17 @@ static inline void splat_batch(ray_ctx *c, uint32_t first, uint32_t m, int whole
 
 /* A leaf range from the tree: its 16-lane blocks with feasible samples,
  * without a call each. */
-static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void range_of(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz,
+                            const int masks)
 {
     ray_ctx *c = ctx;
     for (uint32_t j = 0; j * 16 < n; j++)
         if (mask[j]) {
             uint32_t m = n - 16 * j < 16 ? n - 16 * j : 16, k = mask[j];
-            if (c->mk) { /* the visibility mask's filter (set up at the ray's first splat in this part) */
+            if (masks && c->mk) { /* the visibility mask's filter (set up at the ray's first splat in this part) */
                 if (c->mk == 1)
                     c->mk = 1 + splat_mask_ray(c->s, c->ray, &c->mr);
                 uint32_t kept = splat_mask_filter(&c->mr, first + 16 * j, k);
@@ -379,6 +383,18 @@ static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *m
             }
             splat_batch(c, first + 16 * j, m, m == 16, k, w + 16 * j, iz + 16 * j);
         }
+}
+
+static void splat_range(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w, const float *iz)
+{
+    range_of(ctx, first, n, mask, w, iz, 0);
+}
+
+/* The same for a ray that may have a visibility mask. */
+static void splat_range_mask(void *ctx, uint32_t first, uint32_t n, const uint16_t *mask, const float *w,
+                             const float *iz)
+{
+    range_of(ctx, first, n, mask, w, iz, 1);
 }
 
 /* n floats at p zeroed by all threads (tens of MiB, first touched here
@@ -433,7 +449,7 @@ int splat_maps_splat(splat_state *s)
                 c.t.ready = 0;
                 c.ray = k;
                 c.mk = s->mask && splat_mask_has(s, k);
-                cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, splat_range, &c, &cnt);
+                cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, c.mk ? splat_range_mask : splat_range, &c, &cnt);
             }
             splats += c.splats;
             masked += c.masked;
