@@ -428,6 +428,7 @@ int splat_maps_splat(splat_state *s)
     /* with visibility masks, a batch of rays at a time: their buffers
      * first (the occluders in each frustum), then the splats through them */
     uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
+    const float cap = s->opt.splat.cap > 0.0f ? s->opt.splat.cap : 1.0f; /* as splat_ray_of's */
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
@@ -442,8 +443,22 @@ int splat_maps_splat(splat_state *s)
             c.ray = UINT32_MAX;
             c.splats = c.occluded = c.occl_rays = c.masked = 0;
             c.mk = 0;
+            const cdl_skd_part *pt = &s->tree.parts[part];
             for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
                 const cdl_photon_ray *r = &s->rays.r[k];
+                /* most frusta miss most parts (small kernels): the box of
+                 * the frustum's segment against the part's, a little wider
+                 * than the traversal's own clip (which would reject it
+                 * too), before any of its set-up */
+                const float hmax = r->h0 + r->dh * r->len, t1 = r->len + cap * hmax;
+                const float o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
+                int miss = 0;
+                for (int a = 0; a < 3; a++) {
+                    float e = o[a] + t1 * d[a], g = 1.001f * hmax + 1e-5f * (fabsf(o[a]) + fabsf(e));
+                    miss |= (fminf(o[a], e) - g > pt->bmax[a]) | (fmaxf(o[a], e) + g < pt->bmin[a]);
+                }
+                if (miss)
+                    continue;
                 cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;
                 c.t.ready = 0;
