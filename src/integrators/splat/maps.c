@@ -419,6 +419,42 @@ void splat_maps_clear(splat_state *s)
         zero(s->bw, SPLAT_BW * n);
 }
 
+/* Per ray the parts (up to 64) whose box the box of its frustum's segment
+ * meets, a little wider than the traversal's own clip (which rejects the
+ * others too, after its set-up): with small kernels most frusta miss most
+ * parts, and a part's pass over the rays then reads 8 bytes a ray instead
+ * of the ray. NULL: every part (more than 64, or no memory). */
+static uint64_t *parts_reached(const splat_state *s)
+{
+    const uint32_t np = s->tree.nparts;
+    uint64_t *reach = np <= 64 ? malloc(sizeof *reach * (s->rays.n ? s->rays.n : 1)) : NULL;
+    if (!reach)
+        return NULL;
+    const float cap = s->opt.splat.cap > 0.0f ? s->opt.splat.cap : 1.0f; /* as splat_ray_of's */
+#pragma omp parallel for schedule(static)
+    for (uint32_t k = 0; k < s->rays.n; k++) {
+        const cdl_photon_ray *r = &s->rays.r[k];
+        const float hmax = r->h0 + r->dh * r->len, t1 = r->len + cap * hmax;
+        const float o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
+        float lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            float e = o[a] + t1 * d[a], g = 1.001f * hmax + 1e-5f * (fabsf(o[a]) + fabsf(e));
+            lo[a] = (o[a] < e ? o[a] : e) - g;
+            hi[a] = (o[a] > e ? o[a] : e) + g;
+        }
+        uint64_t m = 0;
+        for (uint32_t p = 0; p < np; p++) {
+            const cdl_skd_part *pt = &s->tree.parts[p];
+            int meet = 1;
+            for (int a = 0; a < 3; a++)
+                meet &= !(lo[a] > pt->bmax[a]) & !(hi[a] < pt->bmin[a]);
+            m |= (uint64_t)meet << p;
+        }
+        reach[k] = m;
+    }
+    return reach;
+}
+
 int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
@@ -428,7 +464,7 @@ int splat_maps_splat(splat_state *s)
     /* with visibility masks, a batch of rays at a time: their buffers
      * first (the occluders in each frustum), then the splats through them */
     uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
-    const float cap = s->opt.splat.cap > 0.0f ? s->opt.splat.cap : 1.0f; /* as splat_ray_of's */
+    uint64_t *reach = parts_reached(s);
     if (s->mask && splat_mask_prepare(s))
         return CDL_ERR_SYSTEM;
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
@@ -443,22 +479,11 @@ int splat_maps_splat(splat_state *s)
             c.ray = UINT32_MAX;
             c.splats = c.occluded = c.occl_rays = c.masked = 0;
             c.mk = 0;
-            const cdl_skd_part *pt = &s->tree.parts[part];
+            const uint64_t bit = part < 64 ? (uint64_t)1 << part : 0;
             for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
-                const cdl_photon_ray *r = &s->rays.r[k];
-                /* most frusta miss most parts (small kernels): the box of
-                 * the frustum's segment against the part's, a little wider
-                 * than the traversal's own clip (which would reject it
-                 * too), before any of its set-up */
-                const float hmax = r->h0 + r->dh * r->len, t1 = r->len + cap * hmax;
-                const float o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
-                int miss = 0;
-                for (int a = 0; a < 3; a++) {
-                    float e = o[a] + t1 * d[a], g = 1.001f * hmax + 1e-5f * (fabsf(o[a]) + fabsf(e));
-                    miss |= (fminf(o[a], e) - g > pt->bmax[a]) | (fmaxf(o[a], e) + g < pt->bmin[a]);
-                }
-                if (miss)
+                if (reach && !(reach[k] & bit))
                     continue;
+                const cdl_photon_ray *r = &s->rays.r[k];
                 cdl_splat_ray sr = splat_ray_of(s, r);
                 c.t.r = r;
                 c.t.ready = 0;
@@ -474,6 +499,7 @@ int splat_maps_splat(splat_state *s)
             nodes += cnt.nodes;
         }
     }
+    free(reach);
     s->st.splats += splats;
     s->st.occluded += occluded;
     s->st.masked += masked;
