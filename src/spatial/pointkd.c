@@ -4,6 +4,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 static float coord(const cdl_kdtree *t, uint32_t i, int a) { return t->pts[(size_t)i * t->stride + (size_t)a]; }
 
@@ -15,37 +18,71 @@ typedef struct kd_rec {
     float p[3];
     uint32_t i;
 } kd_rec;
+_Static_assert(sizeof(kd_rec) == 16, "a record is one 16-byte vector");
 
 /* Quickselect with a three-way partition (robust to equal coordinates):
  * afterwards r[k] holds the k-th smallest coordinate of r[lo..hi), with
- * nothing larger before it and nothing smaller after it. */
+ * nothing larger before it and nothing smaller after it. Each partition
+ * is two branch-free passes, the smaller coordinates to the front and then
+ * the equal ones after them: every record is swapped, and the front only
+ * grows by the comparison's result (a branch per record mispredicts about
+ * half the time on coordinates in no order: the build of gkde's eye
+ * vertices took 15 % of Figure 6). The halves hold the same sets as
+ * with any partition; only equal coordinates may land in another order. */
+static uint32_t front_of(kd_rec *r, uint32_t lo, uint32_t hi, int a, float pivot, int le)
+{
+    uint32_t j = lo;
+    for (uint32_t i = lo; i < hi; i++) {
+        const kd_rec tmp = r[i];
+        const float c = tmp.p[a];
+        r[i] = r[j];
+        r[j] = tmp;
+        j += le ? c <= pivot : c < pivot;
+    }
+    return j;
+}
+
 static void select_kth(kd_rec *r, uint32_t lo, uint32_t hi, uint32_t k, int a)
 {
     while (hi - lo > 1) {
         uint32_t mid = lo + (hi - lo) / 2;
         float x = r[lo].p[a], y = r[mid].p[a], z = r[hi - 1].p[a];
         float pivot = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
-        uint32_t lt = lo, i = lo, gt = hi;
-        while (i < gt) {
-            float c = r[i].p[a];
-            kd_rec tmp = r[i];
-            if (c < pivot) {
-                r[i++] = r[lt];
-                r[lt++] = tmp;
-            } else if (c > pivot) {
-                r[i] = r[--gt];
-                r[gt] = tmp;
-            } else {
-                i++;
-            }
-        }
-        if (k < lt)
+        const uint32_t lt = front_of(r, lo, hi, a, pivot, 0);
+        if (k < lt) {
             hi = lt;
-        else if (k >= gt)
+            continue;
+        }
+        const uint32_t gt = front_of(r, lt, hi, a, pivot, 1);
+        if (k >= gt)
             lo = gt;
         else
             return;
     }
+}
+
+/* The box of r[lo..hi) (a record a vector: its index lane is ignored). */
+static void bounds(const kd_rec *r, uint32_t lo, uint32_t hi, float *mn, float *mx)
+{
+#if defined(__SSE__)
+    __m128 l = _mm_set1_ps(INFINITY), h = _mm_set1_ps(-INFINITY);
+    for (uint32_t i = lo; i < hi; i++) {
+        const __m128 v = _mm_loadu_ps((const float *)(const void *)&r[i]); /* p[3] and i */
+        l = _mm_min_ps(l, v), h = _mm_max_ps(h, v);
+    }
+    float lv[4], hv[4];
+    _mm_storeu_ps(lv, l), _mm_storeu_ps(hv, h);
+    memcpy(mn, lv, 3 * sizeof(float)), memcpy(mx, hv, 3 * sizeof(float));
+#else
+    for (int a = 0; a < 3; a++)
+        mn[a] = INFINITY, mx[a] = -INFINITY;
+    for (uint32_t i = lo; i < hi; i++)
+        for (int a = 0; a < 3; a++) {
+            float c = r[i].p[a];
+            mn[a] = c < mn[a] ? c : mn[a];
+            mx[a] = c > mx[a] ? c : mx[a];
+        }
+#endif
 }
 
 #define TASK_MIN 32768 /* subtrees this big are built as tasks of their own */
@@ -54,13 +91,8 @@ static void select_kth(kd_rec *r, uint32_t lo, uint32_t hi, uint32_t k, int a)
 static void build(cdl_kdtree *t, kd_rec *r, uint32_t lo, uint32_t hi, int tasks)
 {
     while (hi - lo > 1) {
-        float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (uint32_t i = lo; i < hi; i++)
-            for (int a = 0; a < 3; a++) {
-                float c = r[i].p[a];
-                mn[a] = c < mn[a] ? c : mn[a];
-                mx[a] = c > mx[a] ? c : mx[a];
-            }
+        float mn[3], mx[3];
+        bounds(r, lo, hi, mn, mx);
         int a = 0;
         for (int b = 1; b < 3; b++)
             if (mx[b] - mn[b] > mx[a] - mn[a])
