@@ -383,7 +383,7 @@ static uint64_t sky_light(gkde_state *s, uint32_t pass)
     uint64_t rays = 0;
 #pragma omp parallel for schedule(dynamic, 1024) reduction(+ : rays)
     for (uint32_t q = 0; q < s->npts; q++) {
-        const cdl_gkde_eye *ye = &s->eye[q];
+        const cdl_gkde_eye *ye = gkde_eye_of(s, q);
         cdl_rng rng;
         cdl_rng_seed(&rng, cdl_mix64(s->opt.seed ^ 0x6a09e667f3bcc909ULL ^ ((uint64_t)pass << 32)), ye->y);
         for (uint32_t i = 0; i < sc->nlights; i++) {
@@ -594,6 +594,7 @@ static void gkde_destroy(void *self)
     free(s->cum);
     free(s->acc);
     free(s->eye);
+    free((void *)s->eye_ready);
     free(s->pv);
     free(s->pv_new);
     free(s->pixsum);

@@ -65,13 +65,13 @@ int gkde_build_points(gkde_state *s, cdl_error *err)
             return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");                \
         s->f = p_;                                                                                 \
     }
-    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc) GROW(pdepth) GROW(eye)
+    GROW(count) GROW(tested) GROW(unocc) GROW(wsum) GROW(scale) GROW(cum) GROW(acc) GROW(pdepth) GROW(eye) GROW(eye_ready)
 #undef GROW
 #pragma omp parallel for schedule(static)
     for (uint32_t q = 0; q < n; q++) {
         uint32_t y = gkde_point_vertex(s, q);
         s->pdepth[q] = s->evs.depth[y];
-        cdl_gkde_eye_init(&s->g, y, &s->eye[q]);
+        atomic_init(&s->eye_ready[q], 0);
     }
     free(s->parts);
     /* about four parts per thread; results do not depend on the split */
@@ -235,7 +235,7 @@ static void score_links(gkde_state *s, link_ctx *lc)
         uint32_t q = lc->q[i];
         if (i + PREFETCH < lc->n)
             prefetch_eye(s, lc->q[i + PREFETCH]);
-        const cdl_gkde_eye *ye = &s->eye[q];
+        const cdl_gkde_eye *ye = gkde_eye_of(s, q);
         cdl_vec3 c = cdl_gkde_link(&s->g, &par, ye, &b->ls[nb]);
         if (cdl_is_black(c))
             continue;

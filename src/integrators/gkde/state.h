@@ -5,6 +5,7 @@
 #ifndef CDL_GKDE_STATE_H
 #define CDL_GKDE_STATE_H
 
+#include <stdatomic.h>
 #include <string.h>
 
 #include "integrators/integrator.h"
@@ -55,7 +56,8 @@ typedef struct gkde_state {
     uint16_t *pdepth; /* eye depth, in tree order (the candidate test reads it) */
     double *wsum, *scale, *cum;
     cdl_vec3 *acc;
-    cdl_gkde_eye *eye; /* what links read of each point's eye vertex */
+    cdl_gkde_eye *eye; /* what links read of each point's eye vertex, built on first use (gkde_eye_of): */
+    _Atomic unsigned char *eye_ready; /* 0 not yet, 1 being built, 2 built (most points get no link) */
     /* per pixel: tested and unoccluded links, by eye depth 1, 2, 3+: pv of the
      * steps before fold_at (the plan reads these), pv_new of the steps since.
      * Folding at powers of two makes step i's plan a function of steps
@@ -84,6 +86,24 @@ static inline uint32_t gkde_point_vertex(const gkde_state *s, uint32_t q)
     uint32_t e;
     memcpy(&e, &s->pts[4 * (size_t)q + 3], sizeof e);
     return e;
+}
+
+/* Point q's eye record, built by the first thread that asks (any other
+ * waits for it: the record is the same whoever builds it). */
+static inline const cdl_gkde_eye *gkde_eye_of(const gkde_state *s, uint32_t q)
+{
+    _Atomic unsigned char *f = &s->eye_ready[q];
+    if (atomic_load_explicit(f, memory_order_acquire) == 2)
+        return &s->eye[q];
+    unsigned char free_ = 0;
+    if (atomic_compare_exchange_strong_explicit(f, &free_, 1, memory_order_acq_rel, memory_order_acquire)) {
+        cdl_gkde_eye_init(&s->g, gkde_point_vertex(s, q), &s->eye[q]);
+        atomic_store_explicit(f, 2, memory_order_release);
+    } else {
+        while (atomic_load_explicit(f, memory_order_acquire) != 2)
+            ;
+    }
+    return &s->eye[q];
 }
 
 /* The P_vis tally of eye vertex y: its pixel's (tested, unoccluded) pair
