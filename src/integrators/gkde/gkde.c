@@ -98,8 +98,8 @@ static int chunks_reserve(gkde_state *s, uint32_t n, cdl_error *err)
 static size_t stored_bytes(const gkde_state *s)
 {
     return s->rec_bytes + cdl_vs_bytes(&s->lvs) + cdl_vs_bytes(&s->evs) + (size_t)s->evs.cap * sizeof *s->epix +
-           (size_t)s->lvs.cap * (sizeof *s->radius + sizeof *s->lv) +
-           (size_t)s->npts * (4 * sizeof(float) + 5 + 3 * sizeof(uint32_t) + 3 * sizeof(double) +
+           (size_t)s->lvs.cap * (sizeof *s->radius + sizeof *s->lv + 4 * sizeof *s->ball) +
+           (size_t)s->npts * (4 * sizeof(float) + 6 + 3 * sizeof(uint32_t) + 3 * sizeof(double) +
                               sizeof(cdl_vec3) + sizeof(cdl_gkde_eye));
 }
 
@@ -217,15 +217,6 @@ static int trace_lights(gkde_state *s, uint32_t pass, uint64_t *rays, cdl_error 
     return join_chunks(s, &s->lvs, nc, 0, err);
 }
 
-/* Footprint radii (eq. 7) for bandwidth h, and the light vertices that
- * can link: x_k past the start whose parent is not specular, with a
- * bounce left for the eye path. */
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* The footprints in Morton order of their centres: consecutive footprints
  * meet the same eye points, so stages 3-5 find them in cache (the fixed
  * order the stratified draws follow; any fixed order is as good). */
@@ -251,23 +242,53 @@ static int sort_spatially(gkde_state *s, cdl_error *err)
         const float *p = &l->p[s->lv[a]].x;
         key[a] = cdl_morton3(p, lo, sc) << 32 | s->lv[a];
     }
-    qsort(key, n, sizeof *key, cmp_u64);
-    for (uint32_t a = 0; a < n; a++)
-        s->lv[a] = (uint32_t)key[a];
+    /* the 30 Morton bits in three stable passes: ties keep the index order */
+    uint64_t *tmp = malloc(sizeof *tmp * (n ? n : 1));
+    if (!tmp) {
+        free(key);
+        return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
+    }
+    for (int shift = 32; shift < 62; shift += 10) {
+        uint32_t count[1025] = {0};
+        for (uint32_t a = 0; a < n; a++)
+            count[(key[a] >> shift & 1023u) + 1]++;
+        for (int b = 0; b < 1024; b++)
+            count[b + 1] += count[b];
+        for (uint32_t a = 0; a < n; a++)
+            tmp[count[key[a] >> shift & 1023u]++] = key[a];
+        uint64_t *sw = key;
+        key = tmp;
+        tmp = sw;
+    }
+    free(tmp);
+    /* each part's pass over the footprints then reads them in order */
+#pragma omp parallel for schedule(static)
+    for (uint32_t a = 0; a < n; a++) {
+        const uint32_t i = (uint32_t)key[a];
+        s->lv[a] = i;
+        s->ball[4 * (size_t)a] = l->p[i].x, s->ball[4 * (size_t)a + 1] = l->p[i].y;
+        s->ball[4 * (size_t)a + 2] = l->p[i].z, s->ball[4 * (size_t)a + 3] = s->radius[i];
+    }
     free(key);
     return 0;
 }
 
+/* Footprint radii (eq. 7) for bandwidth h, and the light vertices that
+ * can link: x_k past the start whose parent is not specular, with a
+ * bounce left for the eye path. */
 static int footprints(gkde_state *s, float h, cdl_error *err)
 {
     const cdl_vertex_store *l = &s->lvs;
     float *r = realloc(s->radius, sizeof(float) * (l->n ? l->n : 1));
     uint32_t *lv = r ? realloc(s->lv, sizeof(uint32_t) * (l->n ? l->n : 1)) : NULL;
+    float *ball = lv ? realloc(s->ball, 4 * sizeof(float) * (l->n ? l->n : 1)) : NULL;
     if (r)
         s->radius = r;
     if (lv)
         s->lv = lv;
-    if (!r || !lv)
+    if (ball)
+        s->ball = ball;
+    if (!r || !lv || !ball)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
     s->nlv = 0;
     for (uint32_t i = 0; i < l->n; i++) {
@@ -579,6 +600,7 @@ static void gkde_destroy(void *self)
     free(s->epix);
     free(s->radius);
     free(s->lv);
+    free(s->ball);
     cdl_kd_free(&s->kd);
     free(s->pts);
     free(s->parts);

@@ -299,10 +299,11 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
         r->fail = 0;
         count_ctx c = {s, 0.0, 0, r};
         for (uint32_t a = 0; a < s->nlv && !r->fail; a++) {
-            uint32_t xk = s->lv[a];
-            float R = s->radius[xk];
-            if (!cdl_kd_part_meets(sg, s->lvs.p[xk], R))
+            const float *b = &s->ball[4 * (size_t)a];
+            if (!cdl_kd_part_meets(sg, cdl_v3(b[0], b[1], b[2]), b[3]))
                 continue;
+            uint32_t xk = s->lv[a];
+            float R = b[3];
             c.a = accept_weight(s, xk);
             c.max_eye_depth = s->opt.maxdepth - (int)s->lvs.depth[xk] + 1;
             size_t at = r->n;

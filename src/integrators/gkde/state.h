@@ -37,6 +37,7 @@ typedef struct gkde_state {
     uint32_t *epix;   /* pixel of each eye vertex */
     float *radius;    /* footprint radius of each light vertex */
     uint32_t *lv;     /* light vertices with a footprint */
+    float *ball;      /* per entry of lv: its footprint's centre and radius (x, y, z, R), read in order */
     uint32_t nlv;
     float *pts;       /* usable eye vertices in tree order: x, y, z, store index bits */
     uint32_t npts;
