@@ -82,10 +82,10 @@ typedef struct cdl_gkde_parent {
 
 void cdl_gkde_parent_init(const cdl_gkde_ctx *g, uint32_t xk, cdl_gkde_parent *par);
 
-/* An eye vertex y as links read it, built once per step: every link to y
- * reads one record (in the eye points' tree order, so the candidates of a
- * footprint sit together) instead of the scattered store, and y's BSDF is
- * built once, not once per link. */
+/* An eye vertex y as links read it, built at most once per step (when a
+ * link first reaches y: gkde_eye_of): every link to y reads one record (in
+ * the eye points' tree order, so the candidates of a footprint sit together)
+ * instead of the scattered store, and y's BSDF is built once, not per link. */
 #define CDL_GKDE_EYE_INLINE 8
 typedef struct cdl_gkde_eye {
     cdl_bsdf b;
