@@ -464,15 +464,34 @@ int splat_maps_splat(splat_state *s)
     /* with visibility masks, a batch of rays at a time: their buffers
      * first (the occluders in each frustum), then the splats through them */
     uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
+    const uint32_t np = s->tree.nparts;
     uint64_t *reach = parts_reached(s);
-    if (s->mask && splat_mask_prepare(s))
+    uint32_t *order = malloc(sizeof *order * (np ? np : 1));
+    if (!order || (s->mask && splat_mask_prepare(s))) {
+        free(order);
+        free(reach);
         return CDL_ERR_SYSTEM;
+    }
+    /* the parts with the most samples first: a part's cost grows with its
+     * samples, and the threads then finish together (in tree order the
+     * last large part ran alone for 7 % of the Cornell box's splatting);
+     * each part sums its splats in ray order, so the image is the same */
+    for (uint32_t j = 0; j < np; j++) {
+        uint32_t p = j, n = s->tree.parts[p].hi - s->tree.parts[p].lo, i = j;
+        for (; i > 0 && s->tree.parts[order[i - 1]].hi - s->tree.parts[order[i - 1]].lo < n; i--)
+            order[i] = order[i - 1];
+        order[i] = p;
+    }
     for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
         uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
-        if (s->mask && splat_mask_build(s, k0, k1 - k0))
+        if (s->mask && splat_mask_build(s, k0, k1 - k0)) {
+            free(order);
+            free(reach);
             return CDL_ERR_SYSTEM;
+        }
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, occluded, occl_rays, masked)
-        for (uint32_t part = 0; part < s->tree.nparts; part++) {
+        for (uint32_t j = 0; j < np; j++) {
+            const uint32_t part = order[j];
             cdl_skd_count cnt = {0, 0, 0};
             ray_ctx c;
             c.s = s;
@@ -499,6 +518,7 @@ int splat_maps_splat(splat_state *s)
             nodes += cnt.nodes;
         }
     }
+    free(order);
     free(reach);
     s->st.splats += splats;
     s->st.occluded += occluded;
