@@ -36,6 +36,7 @@
 
 #include "core/log.h"
 #include "core/morton.h"
+#include "core/radix.h"
 #include "core/rng.h"
 #include "integrators/gkde/points.h"
 
@@ -248,19 +249,9 @@ static int sort_spatially(gkde_state *s, cdl_error *err)
         free(key);
         return cdl_error_set(err, CDL_ERR_SYSTEM, "gkde", 0, "out of memory");
     }
-    for (int shift = 32; shift < 62; shift += 10) {
-        uint32_t count[1025] = {0};
-        for (uint32_t a = 0; a < n; a++)
-            count[(key[a] >> shift & 1023u) + 1]++;
-        for (int b = 0; b < 1024; b++)
-            count[b + 1] += count[b];
-        for (uint32_t a = 0; a < n; a++)
-            tmp[count[key[a] >> shift & 1023u]++] = key[a];
-        uint64_t *sw = key;
-        key = tmp;
-        tmp = sw;
-    }
-    free(tmp);
+    uint64_t *sorted = cdl_radix_sort_bits(key, tmp, n, 32, 62);
+    free(sorted == key ? tmp : key);
+    key = sorted;
     /* each part's pass over the footprints then reads them in order */
 #pragma omp parallel for schedule(static)
     for (uint32_t a = 0; a < n; a++) {

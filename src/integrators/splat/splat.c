@@ -35,6 +35,7 @@
 
 #include "core/log.h"
 #include "core/morton.h"
+#include "core/radix.h"
 #include "transport/light_select.h"
 #include "transport/visible.h"
 
@@ -338,19 +339,9 @@ static int sort_rays(splat_state *s, cdl_error *err)
         cdl_vec3 e = cdl_add(r[k].o, cdl_scale(r[k].d, r[k].len));
         key[k] = cdl_morton3(&e.x, lo, sc) << 32 | k;
     }
-    for (int shift = 32; shift < 62; shift += 10) {
-        uint32_t count[1025] = {0};
-        for (uint32_t k = 0; k < n; k++)
-            count[(key[k] >> shift & 1023u) + 1]++;
-        for (int b = 0; b < 1024; b++)
-            count[b + 1] += count[b];
-        for (uint32_t k = 0; k < n; k++)
-            tmp[count[key[k] >> shift & 1023u]++] = key[k];
-        uint64_t *sw = key;
-        key = tmp;
-        tmp = sw;
-    }
-    free(tmp);
+    uint64_t *sorted = cdl_radix_sort_bits(key, tmp, n, 32, 62);
+    free(sorted == key ? tmp : key);
+    key = sorted;
     cdl_photon_ray *out = malloc(sizeof *out * (s->rays.cap ? s->rays.cap : 1));
     if (out) {
 #pragma omp parallel for schedule(static)
