@@ -340,7 +340,18 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
     double t1 = cdl_time_now();
     s->st.t_count += t1 - t0;
     s->st.candidates += (double)cand;
-    /* stages 4 and 5: trial links, shadow-ray bundles, scores */
+    /* stages 4 and 5: trial links, shadow-ray bundles, scores; the parts
+     * with the most candidate records first, so the threads finish
+     * together (each part's links are its own: the same result) */
+    uint32_t *order = malloc(sizeof *order * (s->nparts ? s->nparts : 1));
+    if (!order)
+        return UINT64_MAX;
+    for (uint32_t j = 0; j < s->nparts; j++) {
+        uint32_t i = j;
+        for (; i > 0 && s->rec[order[i - 1]].n < s->rec[j].n; i--)
+            order[i] = order[i - 1];
+        order[i] = j;
+    }
     double t_link = 0.0, t_rays = 0.0, t_score = 0.0;
     uint64_t trials = 0, rays = 0;
 #pragma omp parallel reduction(+ : t_link, t_rays, t_score, trials, rays)
@@ -348,7 +359,8 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
         link_ctx *lc = malloc(sizeof *lc);
         bundle *b = malloc(sizeof *b);
 #pragma omp for schedule(dynamic, 1)
-        for (uint32_t g = 0; g < s->nparts; g++) {
+        for (uint32_t j = 0; j < s->nparts; j++) {
+            const uint32_t g = order[j];
             if (!lc || !b || cdl_cancelled(s->cancel))
                 continue;
             const cdl_kd_part *sg = &s->parts[g];
@@ -389,6 +401,7 @@ uint64_t gkde_link_all(gkde_state *s, uint32_t pass)
         free(lc);
         free(b);
     }
+    free(order);
     s->st.t_link += t_link;
     s->st.t_rays += t_rays;
     s->st.t_score += t_score;
