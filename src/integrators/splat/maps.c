@@ -455,19 +455,53 @@ static uint64_t *parts_reached(const splat_state *s)
     return reach;
 }
 
+/* What the parts' splatting counts. */
+typedef struct splat_sums {
+    uint64_t splats, tested, nodes, occluded, occl_rays, masked;
+} splat_sums;
+
+/* Part `part`'s splats of rays [k0, k1), in their order. */
+static void splat_part(splat_state *s, uint32_t part, uint32_t k0, uint32_t k1, const uint64_t *reach, int flags,
+                       splat_sums *sum)
+{
+    cdl_skd_count cnt = {0, 0, 0};
+    ray_ctx c;
+    c.s = s;
+    c.ray = UINT32_MAX;
+    c.splats = c.occluded = c.occl_rays = c.masked = 0;
+    c.mk = 0;
+    const uint64_t bit = part < 64 ? (uint64_t)1 << part : 0;
+    for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
+        if (reach && !(reach[k] & bit))
+            continue;
+        const cdl_photon_ray *r = &s->rays.r[k];
+        cdl_splat_ray sr = splat_ray_of(s, r);
+        c.t.r = r;
+        c.t.ready = 0;
+        c.ray = k;
+        c.mk = s->mask && splat_mask_has(s, k);
+        cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, c.mk ? splat_range_mask : splat_range, &c, &cnt);
+    }
+    sum->splats += c.splats;
+    sum->masked += c.masked;
+    sum->occluded += c.occluded;
+    sum->occl_rays += c.occl_rays;
+    sum->tested += cnt.tested;
+    sum->nodes += cnt.nodes;
+}
+
+/* The visibility masks' rays are built in chunks of this many. */
+#define MASK_CHUNK 16u
+
 int splat_maps_splat(splat_state *s)
 {
     splat_maps_clear(s);
-    uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0, masked = 0;
     const int flags = (s->opt.splat.cull ? CDL_SKD_CULL : 0) | (s->opt.splat.slabs ? CDL_SKD_SLABS : 0) |
                       (s->occl || s->want_bw ? 0 : CDL_SKD_NOIZ);
-    /* with visibility masks, a batch of rays at a time: their buffers
-     * first (the occluders in each frustum), then the splats through them */
-    uint32_t batch = s->mask ? splat_mask_batch(s) : (s->rays.n ? s->rays.n : 1);
-    const uint32_t np = s->tree.nparts;
+    const uint32_t n = s->rays.n, np = s->tree.nparts;
     uint64_t *reach = parts_reached(s);
     uint32_t *order = malloc(sizeof *order * (np ? np : 1));
-    if (!order || (s->mask && splat_mask_prepare(s))) {
+    if (!order || (s->mask && (splat_mask_prepare(s) || splat_mask_begin(s)))) {
         free(order);
         free(reach);
         return CDL_ERR_SYSTEM;
@@ -477,55 +511,58 @@ int splat_maps_splat(splat_state *s)
      * last large part ran alone for 7 % of the Cornell box's splatting);
      * each part sums its splats in ray order, so the image is the same */
     for (uint32_t j = 0; j < np; j++) {
-        uint32_t p = j, n = s->tree.parts[p].hi - s->tree.parts[p].lo, i = j;
-        for (; i > 0 && s->tree.parts[order[i - 1]].hi - s->tree.parts[order[i - 1]].lo < n; i--)
+        uint32_t p = j, m = s->tree.parts[p].hi - s->tree.parts[p].lo, i = j;
+        for (; i > 0 && s->tree.parts[order[i - 1]].hi - s->tree.parts[order[i - 1]].lo < m; i--)
             order[i] = order[i - 1];
         order[i] = p;
     }
-    for (uint32_t k0 = 0; k0 < s->rays.n && !cdl_cancelled(s->cancel); k0 += batch) {
-        uint32_t k1 = s->rays.n - k0 < batch ? s->rays.n : k0 + batch;
-        if (s->mask && splat_mask_build(s, k0, k1 - k0)) {
-            free(order);
-            free(reach);
-            return CDL_ERR_SYSTEM;
+    /* with visibility masks, a batch of rays at a time (their buffers stay
+     * in cache): the parts splat one batch while the threads that run out
+     * of parts build the next one's buffers (the occluders in each
+     * frustum) */
+    const uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (n ? n : 1), nb = (n + batch - 1) / batch;
+    splat_sums sum = {0, 0, 0, 0, 0, 0};
+#pragma omp parallel
+    {
+        splat_sums mine = {0, 0, 0, 0, 0, 0};
+        if (s->mask) {
+            const uint32_t k1 = n < batch ? n : batch;
+#pragma omp for schedule(dynamic, 1)
+            for (uint32_t k = 0; k < k1; k += MASK_CHUNK)
+                splat_mask_build(s, k, k1 - k < MASK_CHUNK ? k1 : k + MASK_CHUNK);
         }
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : splats, tested, nodes, occluded, occl_rays, masked)
-        for (uint32_t j = 0; j < np; j++) {
-            const uint32_t part = order[j];
-            cdl_skd_count cnt = {0, 0, 0};
-            ray_ctx c;
-            c.s = s;
-            c.ray = UINT32_MAX;
-            c.splats = c.occluded = c.occl_rays = c.masked = 0;
-            c.mk = 0;
-            const uint64_t bit = part < 64 ? (uint64_t)1 << part : 0;
-            for (uint32_t k = k0; k < k1 && !cdl_cancelled(s->cancel); k++) {
-                if (reach && !(reach[k] & bit))
-                    continue;
-                const cdl_photon_ray *r = &s->rays.r[k];
-                cdl_splat_ray sr = splat_ray_of(s, r);
-                c.t.r = r;
-                c.t.ready = 0;
-                c.ray = k;
-                c.mk = s->mask && splat_mask_has(s, k);
-                cdl_skd_splat_visit_range(&s->tree, part, &sr, flags, c.mk ? splat_range_mask : splat_range, &c, &cnt);
-            }
-            splats += c.splats;
-            masked += c.masked;
-            occluded += c.occluded;
-            occl_rays += c.occl_rays;
-            tested += cnt.tested;
-            nodes += cnt.nodes;
+        for (uint32_t b = 0; b < nb; b++) {
+            const uint32_t k0 = b * batch, k1 = n - k0 < batch ? n : k0 + batch;
+            const uint32_t k2 = n - k1 < batch ? n : k1 + batch;
+            const uint32_t nc = s->mask ? (k2 - k1 + MASK_CHUNK - 1) / MASK_CHUNK : 0;
+#pragma omp for schedule(dynamic, 1)
+            for (uint32_t j = 0; j < np + nc; j++)
+                if (j < np)
+                    splat_part(s, order[j], k0, k1, reach, flags, &mine);
+                else {
+                    const uint32_t lo = k1 + (j - np) * MASK_CHUNK;
+                    splat_mask_build(s, lo, k2 - lo < MASK_CHUNK ? k2 : lo + MASK_CHUNK);
+                }
+            /* (the loop's barrier: this batch's splats are done) */
+            if (s->mask)
+                splat_mask_recycle(s, k0);
+        }
+#pragma omp critical(splat_sums)
+        {
+            sum.splats += mine.splats, sum.tested += mine.tested, sum.nodes += mine.nodes;
+            sum.occluded += mine.occluded, sum.occl_rays += mine.occl_rays, sum.masked += mine.masked;
         }
     }
     free(order);
     free(reach);
-    s->st.splats += splats;
-    s->st.occluded += occluded;
-    s->st.masked += masked;
-    s->st.occl_rays += occl_rays;
-    s->st.tested += tested;
-    s->st.nodes += nodes;
+    if (s->mask && splat_mask_end(s))
+        return CDL_ERR_SYSTEM;
+    s->st.splats += sum.splats;
+    s->st.occluded += sum.occluded;
+    s->st.masked += sum.masked;
+    s->st.occl_rays += sum.occl_rays;
+    s->st.tested += sum.tested;
+    s->st.nodes += sum.nodes;
     return 0;
 }
 

@@ -53,12 +53,14 @@
 #define NONE UINT32_MAX
 #define PLANES 8
 
-/* Per thread: the buffers of the batch's rays it took, one after another. */
+/* Per thread: the buffers of the rays it took, one after another, per
+ * batch slot (the batches alternate between two: one is built while the
+ * other's splats are filtered). */
 typedef struct mask_worker {
-    _Alignas(64) uint32_t *cells; /* the buffers, each g^2 distance bits then g^2 samples (a cache line
-                                   * of its own: the threads write theirs all the time) */
-    uint64_t *grid;               /* MASK_G^2 keys: the ray being rasterized */
-    uint32_t ncell, capcell;
+    _Alignas(64) uint32_t *cells[2]; /* the buffers, each g^2 distance bits then g^2 samples (a cache line
+                                      * of its own: the threads write theirs all the time) */
+    uint64_t *grid;                  /* MASK_G^2 keys: the ray being rasterized */
+    uint32_t ncell[2], capcell[2];
     int oom;
     mask_ray x;   /* the ray being built */
     mask_held *held; /* its occluders */
@@ -68,11 +70,10 @@ typedef struct mask_worker {
      * many normals to ask) */
     cdl_skd_plane pl[PLANES];
     int np, last; /* last: the plane the last lane had */
-    uint64_t rasterized, tested;
+    uint64_t rasterized, tested, buffers;
 } mask_worker;
 
 struct splat_mask {
-    uint32_t first;     /* the batch's first ray */
     float rho;          /* the eye samples' median footprint: the smallest cell worth having */
     float *pw;          /* per eye sample (tree order) its footprint */
     uint32_t npw;
@@ -86,27 +87,21 @@ struct splat_mask {
     uint32_t nocc;
     mask_worker *w;
     int nw;
-    uint32_t *roff, *rw; /* per ray of the batch: its buffer's offset (NONE: none) and worker */
-    uint8_t *rg;         /* and side in cells */
+    /* per slot, per ray of its batch: its buffer's offset (NONE: none), worker and side in cells */
+    uint32_t *roff[2], *rw[2];
+    uint8_t *rg[2];
 };
-
-uint32_t splat_mask_batch(const splat_state *s)
-{
-    (void)s;
-    return SPLAT_MASK_BATCH;
-}
 
 int splat_mask_alloc(splat_state *s, cdl_error *err)
 {
     if (s->mask)
         return 0;
     splat_mask *m = s->mask = calloc(1, sizeof *m);
-    if (m) {
-        m->roff = malloc(sizeof *m->roff * SPLAT_MASK_BATCH);
-        m->rw = malloc(sizeof *m->rw * SPLAT_MASK_BATCH);
-        m->rg = malloc(SPLAT_MASK_BATCH);
-    }
-    if (!m || !m->roff || !m->rw || !m->rg)
+    int ok = m != NULL;
+    for (int i = 0; ok && i < 2; i++)
+        ok = (m->roff[i] = malloc(sizeof *m->roff[i] * SPLAT_MASK_BATCH)) &&
+             (m->rw[i] = malloc(sizeof *m->rw[i] * SPLAT_MASK_BATCH)) && (m->rg[i] = malloc(SPLAT_MASK_BATCH));
+    if (!ok)
         return cdl_error_set(err, CDL_ERR_SYSTEM, "splat", 0, "out of memory for the visibility masks");
     return 0;
 }
@@ -130,14 +125,17 @@ void splat_mask_free(splat_state *s)
     if (!m)
         return;
     for (int i = 0; i < m->nw; i++) {
-        free(m->w[i].cells);
+        free(m->w[i].cells[0]);
+        free(m->w[i].cells[1]);
         free(m->w[i].grid);
         free(m->w[i].held);
     }
     free(m->w);
-    free(m->roff);
-    free(m->rw);
-    free(m->rg);
+    for (int i = 0; i < 2; i++) {
+        free(m->roff[i]);
+        free(m->rw[i]);
+        free(m->rg[i]);
+    }
     free(m->pw);
     occ_free(m);
     free(m);
@@ -149,10 +147,10 @@ size_t splat_mask_bytes(const splat_state *s)
     const splat_mask *m = s->mask;
     if (!m)
         return 0;
-    size_t b = (size_t)SPLAT_MASK_BATCH * 9 + sizeof(float) * (size_t)m->npw + cdl_skd_bytes(&m->occ) +
+    size_t b = (size_t)SPLAT_MASK_BATCH * 18 + sizeof(float) * (size_t)m->npw + cdl_skd_bytes(&m->occ) +
                (size_t)m->nocc * (7 * sizeof(float) + sizeof(uint32_t) + 1);
     for (int i = 0; i < m->nw; i++)
-        b += (size_t)m->w[i].capcell * sizeof(uint32_t) + (size_t)m->w[i].caph * sizeof(mask_held) +
+        b += (size_t)(m->w[i].capcell[0] + m->w[i].capcell[1]) * sizeof(uint32_t) + (size_t)m->w[i].caph * sizeof(mask_held) +
              (m->w[i].grid ? sizeof(uint64_t) * MASK_G * MASK_G : 0);
     return b;
 }
@@ -539,15 +537,19 @@ static void collect(void *ctx, uint32_t first, uint32_t mlen, uint32_t any, cons
     }
 }
 
-/* Ray k of the batch on worker wid: its occluders found; a buffer only
- * if some sample it feeds lies behind one's plane (else nothing can be
- * hidden), made and filled. */
+/* The slot of the batch ray k belongs to, and its index there. */
+static inline uint32_t slot_of(uint32_t k) { return k / SPLAT_MASK_BATCH & 1u; }
+
+/* Ray k on worker wid: its occluders found; a buffer only if some sample
+ * it feeds lies behind one's plane (else nothing can be hidden), made and
+ * filled. */
 static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
 {
     splat_mask *m = s->mask;
     mask_worker *x = &m->w[wid];
-    const cdl_photon_ray *r = &s->rays.r[m->first + k];
-    m->roff[k] = NONE;
+    const uint32_t sl = slot_of(k), i = k % SPLAT_MASK_BATCH;
+    const cdl_photon_ray *r = &s->rays.r[k];
+    m->roff[sl][i] = NONE;
     int g = cells_of(m, r);
     if (!g || !m->nocc || x->oom)
         return;
@@ -562,7 +564,7 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
         (x->np <= PLANES && !cdl_skd_any_behind(&s->tree, &sr, s->opt.splat.cull ? CDL_SKD_CULL : 0, x->pl, x->np, m->pw, &cnt)))
         return;
     const uint32_t gg = (uint32_t)(g * g);
-    if (cdl_grow((void **)&x->cells, &x->capcell, x->ncell + 2 * gg, sizeof *x->cells)) {
+    if (cdl_grow((void **)&x->cells[sl], &x->capcell[sl], x->ncell[sl] + 2 * gg, sizeof *x->cells[sl])) {
         x->oom = 1;
         return;
     }
@@ -573,25 +575,26 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
         x->rasterized += (uint64_t)__builtin_popcount(splat_mask_rasterize_z(&x->x, x->held[b].first, x->held[b].mask, x->held[b].z));
     /* split for the filter: one gather of distances, one of samples where
      * they are near enough */
-    uint32_t *zg = x->cells + x->ncell, *ig = zg + gg;
+    uint32_t *zg = x->cells[sl] + x->ncell[sl], *ig = zg + gg;
     for (uint32_t c = 0; c < gg; c++) {
         zg[c] = grid[c] == UINT64_MAX ? (uint32_t)INT32_MAX : (uint32_t)(grid[c] >> 32);
         ig[c] = (uint32_t)grid[c];
     }
-    m->roff[k] = x->ncell;
-    m->rw[k] = wid;
-    m->rg[k] = (uint8_t)g;
-    x->ncell += 2 * gg;
+    m->roff[sl][i] = x->ncell[sl];
+    m->rw[sl][i] = wid;
+    m->rg[sl][i] = (uint8_t)g;
+    x->ncell[sl] += 2 * gg;
+    x->buffers++;
 }
 
-/* Workers for every thread, their buffers emptied for a new batch. */
-static int workers(splat_mask *m)
+int splat_mask_begin(splat_state *s)
 {
+    splat_mask *m = s->mask;
     int nth = omp_get_max_threads();
     if (nth > m->nw) {
         mask_worker *w = aligned_alloc(64, sizeof *w * (size_t)nth); /* sizeof is a multiple of 64 */
         if (!w)
-            return -1;
+            return CDL_ERR_SYSTEM;
         if (m->nw)
             memcpy(w, m->w, sizeof *w * (size_t)m->nw);
         free(m->w);
@@ -601,48 +604,58 @@ static int workers(splat_mask *m)
     }
     for (int i = 0; i < m->nw; i++) {
         if (!m->w[i].grid && !(m->w[i].grid = malloc(sizeof(uint64_t) * MASK_G * MASK_G)))
-            return -1;
-        m->w[i].ncell = 0;
+            return CDL_ERR_SYSTEM;
+        m->w[i].ncell[0] = m->w[i].ncell[1] = 0;
         m->w[i].oom = 0;
-        m->w[i].rasterized = m->w[i].tested = 0;
+        m->w[i].rasterized = m->w[i].tested = m->w[i].buffers = 0;
     }
     return 0;
 }
 
-int splat_mask_build(splat_state *s, uint32_t first, uint32_t n)
+void splat_mask_build(splat_state *s, uint32_t lo, uint32_t hi)
+{
+    const int wid = omp_get_thread_num();
+    for (uint32_t k = lo; k < hi; k++)
+        if (wid < s->mask->nw)
+            build_ray(s, (uint32_t)wid, k);
+        else /* more threads than at begin (never with one team): no buffer */
+            s->mask->roff[slot_of(k)][k % SPLAT_MASK_BATCH] = NONE;
+}
+
+void splat_mask_recycle(splat_state *s, uint32_t k)
+{
+    const int wid = omp_get_thread_num();
+    if (wid < s->mask->nw)
+        s->mask->w[wid].ncell[slot_of(k)] = 0;
+}
+
+int splat_mask_end(splat_state *s)
 {
     splat_mask *m = s->mask;
-    m->first = first;
-    if (workers(m))
-        return CDL_ERR_SYSTEM;
-#pragma omp parallel
-    {
-        uint32_t wid = (uint32_t)omp_get_thread_num();
-#pragma omp for schedule(dynamic, 16)
-        for (uint32_t k = 0; k < n; k++)
-            build_ray(s, wid, k);
-    }
+    int rc = 0;
     for (int i = 0; i < m->nw; i++) {
         if (m->w[i].oom)
-            return CDL_ERR_SYSTEM;
+            rc = CDL_ERR_SYSTEM;
         s->st.rasterized += m->w[i].rasterized;
         s->st.mask_tested += m->w[i].tested;
+        s->st.mask_buffers += m->w[i].buffers;
     }
-    for (uint32_t k = 0; k < n; k++)
-        s->st.mask_buffers += m->roff[k] != NONE;
-    return 0;
+    return rc;
 }
 
-int splat_mask_has(const splat_state *s, uint32_t ray) { return s->mask->roff[ray - s->mask->first] != NONE; }
+int splat_mask_has(const splat_state *s, uint32_t k)
+{
+    return s->mask->roff[slot_of(k)][k % SPLAT_MASK_BATCH] != NONE;
+}
 
-int splat_mask_ray(const splat_state *s, uint32_t ray, mask_ray *x)
+int splat_mask_ray(const splat_state *s, uint32_t k, mask_ray *x)
 {
     const splat_mask *m = s->mask;
-    const uint32_t k = ray - m->first;
-    if (m->roff[k] == NONE)
+    const uint32_t sl = slot_of(k), i = k % SPLAT_MASK_BATCH;
+    if (m->roff[sl][i] == NONE)
         return 0;
-    ray_frame(s, &s->rays.r[ray], m->rg[k], x);
-    x->zg = m->w[m->rw[k]].cells + m->roff[k];
+    ray_frame(s, &s->rays.r[k], m->rg[sl][i], x);
+    x->zg = m->w[m->rw[sl][i]].cells[sl] + m->roff[sl][i];
     x->ig = x->zg + (uint32_t)(x->g * x->g);
     return 1;
 }
