@@ -3,7 +3,10 @@
  * rows z-min in registers) fills the buffer exactly as one cell at a time
  * does, bit for bit, on clustered batches (windows of 1 x 1 to 8 x 8
  * cells), spread ones (the cell by cell path), several grid sizes, and
- * with the reach cutting some lanes. */
+ * with the reach cutting some lanes; and a buffer that keeps a plane per
+ * cell hides exactly the samples one that keeps the occluder does, for
+ * occluders on three planes (facing the ray, tilted, and with the origin
+ * behind it). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,6 +25,98 @@ static uint32_t bits(float f)
     uint32_t u;
     memcpy(&u, &f, sizeof u);
     return u;
+}
+
+/* Occluders on three planes, rasterized once by index and once by plane;
+ * feasible samples throughout the frustum filtered through both. */
+#define NF (16 * 256)
+#define NH 48
+/* the feasible samples, then the occluders (the index filter reads their
+ * planes from the feasible samples' tree, as in the renderer) */
+static float fpos[3][NF + 16 * NH + 16], fnrm[3][NF + 16 * NH + 16], fpw[NF + 16];
+static uint32_t fid[16 * NH + 16];
+
+static void planes_match(const cdl_photon_ray *r, const float *const *axp)
+{
+    cdl_rng rng;
+    cdl_rng_seed(&rng, 29, 1);
+    const float pn[3][3] = {{0.0f, 0.0f, -1.0f}, {0.6f, 0.0f, -0.8f}, {0.0f, 0.0f, 1.0f}};
+    const float pc[3] = {-1.0f, -1.2f, 2.5f}; /* p . n on each plane */
+    static mask_held h[NH];
+    for (uint32_t b = 0; b < NH; b++) {
+        const int k = (int)(b % 3);
+        h[b].first = 16 * b, h[b].mask = 0xffffu;
+        for (uint32_t i = 0; i < 16; i++) {
+            uint32_t q = 16 * b + i;
+            float x = 1.2f * (cdl_rng_float(&rng) - 0.5f), y = 1.2f * (cdl_rng_float(&rng) - 0.5f);
+            /* on plane k: solve n . p = c for z */
+            float z = (pc[k] - pn[k][0] * x - pn[k][1] * y) / pn[k][2];
+            pos[0][q] = x, pos[1][q] = y, pos[2][q] = z;
+            for (int c = 0; c < 3; c++)
+                nrm[c][q] = pn[k][c];
+            pw[q] = 0.01f;
+            h[b].z[i] = z;
+            h[b].pid[i] = (uint8_t)k;
+            fid[q] = NF + q;
+            for (int c = 0; c < 3; c++)
+                fpos[c][NF + q] = pos[c][q], fnrm[c][NF + q] = pn[k][c];
+        }
+    }
+    /* the planes turned away from the origin (the side they hide), offsets
+     * p . n */
+    float tab[4 * MASK_PLANES];
+    memset(tab, 0, sizeof tab);
+    for (int k = 0; k < 3; k++) {
+        float s = -pc[k] > 0.0f ? -1.0f : 1.0f; /* (o - q) . n > 0: turned */
+        for (int c = 0; c < 3; c++)
+            tab[c * MASK_PLANES + k] = s * pn[k][c];
+        tab[3 * MASK_PLANES + k] = s * pc[k];
+    }
+    for (uint32_t q = 0; q < NF; q++) {
+        float z = 0.5f + 3.5f * cdl_rng_float(&rng), hz = r->h0 + r->dh * (z < r->len ? z : r->len);
+        fpos[0][q] = 1.8f * hz * (cdl_rng_float(&rng) - 0.5f);
+        fpos[1][q] = 1.8f * hz * (cdl_rng_float(&rng) - 0.5f);
+        fpos[2][q] = z;
+        fpw[q] = 0.002f + 0.03f * cdl_rng_float(&rng);
+    }
+    cdl_skd t, ft;
+    memset(&t, 0, sizeof t);
+    memset(&ft, 0, sizeof ft);
+    for (int c = 0; c < 3; c++)
+        t.p[c] = pos[c], t.nrm[c] = nrm[c], ft.p[c] = fpos[c], ft.nrm[c] = fnrm[c];
+    t.n = 16 * NH, ft.n = NF;
+    const int g = 32, gg = g * g;
+    uint64_t *gi = malloc(sizeof *gi * gg), *gp = malloc(sizeof *gp * gg);
+    uint32_t *zg = malloc(sizeof *zg * gg), *ig = malloc(sizeof *ig * gg), *cz = malloc(sizeof *cz * gg);
+    uint32_t occ[MASK_G * MASK_G / 32];
+    memset(occ, 0, sizeof occ);
+    mask_ray xi = {.t = &t, .r = r, .pw = pw, .ax = axp, .U = {1.0f, 0.0f, 0.0f}, .V = {0.0f, 1.0f, 0.0f},
+                   .eps = 1e-5f, .g = g, .reach = INT32_MAX, .grid = gi, .id = fid, .ft = &ft, .fpw = fpw};
+    mask_ray xp = xi;
+    xp.grid = gp;
+    for (int c = 0; c < gg; c++)
+        gi[c] = gp[c] = UINT64_MAX;
+    for (uint32_t b = 0; b < NH; b++) {
+        splat_mask_rasterize_z(&xi, h[b].first, h[b].mask, h[b].z, NULL);
+        splat_mask_rasterize_z(&xp, h[b].first, h[b].mask, h[b].z, h[b].pid);
+    }
+    for (int c = 0; c < gg; c++) {
+        int full = gi[c] != UINT64_MAX;
+        zg[c] = full ? (uint32_t)(gi[c] >> 32) : (uint32_t)INT32_MAX, ig[c] = (uint32_t)gi[c];
+        cz[c] = full ? ((uint32_t)(gp[c] >> 32) & ~(uint32_t)(MASK_PLANES - 1)) | (uint32_t)gp[c] : (uint32_t)INT32_MAX;
+        occ[c >> 5] |= (uint32_t)full << (c & 31);
+    }
+    xi.zg = zg, xi.ig = ig;
+    xp.cz = cz, xp.occ = occ, xp.tab = tab;
+    uint32_t hidden = 0, differ = 0;
+    for (uint32_t q = 0; q < NF; q += 16) {
+        uint32_t a = splat_mask_filter(&xi, q, 0xffffu), b = splat_mask_filter(&xp, q, 0xffffu);
+        hidden += (uint32_t)__builtin_popcount(~a & 0xffffu);
+        differ += (uint32_t)__builtin_popcount(a ^ b);
+    }
+    CHECK(differ == 0 && hidden > NF / 20 && hidden < NF - NF / 20,
+          "planes per cell hide what occluders per cell do (%u of %u differ, %u hidden)", differ, NF, hidden);
+    free(gi), free(gp), free(zg), free(ig), free(cz);
 }
 
 int main(void)
@@ -99,5 +194,6 @@ int main(void)
     free(g0);
     free(g1);
     free(held);
+    planes_match(&r, axp);
     return test_failures ? 1 : 0;
 }

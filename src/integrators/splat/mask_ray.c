@@ -59,7 +59,7 @@ static inline void cell_min(uint64_t *c, uint64_t key) { *c = key < *c ? key : *
  * update of the grid per row. Scalar updates of the grid each load what
  * the one before stored: a chain of store forwards. */
 static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, const int (*box)[16], const uint32_t *zk,
-                           int A0, int B0, int B1, const int R)
+                           const uint8_t *pid, int A0, int B0, int B1, const int R)
 {
     const __m512i one = _mm512_set1_epi32(1), two = _mm512_set1_epi32(2);
     const __m512i a0 = _mm512_loadu_si512(box[0]), a1 = _mm512_loadu_si512(box[1]);
@@ -76,9 +76,10 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
     }
     uint64_t key[16];
     const __m512i z = _mm512_loadu_si512(zk);
-    const __m512i idx = x->id ? _mm512_loadu_si512(x->id + first)
-                              : _mm512_add_epi32(_mm512_set1_epi32((int)first),
-                                                 _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+    const __m512i idx = pid    ? _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)pid))
+                        : x->id ? _mm512_loadu_si512(x->id + first)
+                                : _mm512_add_epi32(_mm512_set1_epi32((int)first),
+                                                   _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
     _mm512_storeu_si512(key, _mm512_or_si512(_mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_castsi512_si256(z)), 32),
                                              _mm512_cvtepu32_epi64(_mm512_castsi512_si256(idx))));
     _mm512_storeu_si512(key + 8,
@@ -116,10 +117,16 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
 
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
 {
-    return (uint32_t)__builtin_popcount(splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z));
+    return (uint32_t)__builtin_popcount(splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z, NULL));
 }
 
-uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz)
+/* The low word of lane i's key: its plane, or its index. */
+static inline uint32_t key_lo(const mask_ray *x, uint32_t first, const uint8_t *pid, int i)
+{
+    return pid ? pid[i] : x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i;
+}
+
+uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, const uint8_t *pid)
 {
     const cdl_skd *t = x->t;
     const cdl_photon_ray *r = x->r;
@@ -215,18 +222,18 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
         const int A1 = 255 - (int)(e >> 16 & 255u), B1 = 255 - (int)(e >> 24);
         if (A1 - A0 < 8 && B1 - B0 < 8) {
             if (B1 - B0 < 2)
-                window8(x, first, live, box, zk, A0, B0, B1, 2);
+                window8(x, first, live, box, zk, pid, A0, B0, B1, 2);
             else if (B1 - B0 < 4)
-                window8(x, first, live, box, zk, A0, B0, B1, 4);
+                window8(x, first, live, box, zk, pid, A0, B0, B1, 4);
             else
-                window8(x, first, live, box, zk, A0, B0, B1, 8);
+                window8(x, first, live, box, zk, pid, A0, B0, B1, 8);
             return live;
         }
     }
 #endif
     for (uint32_t m = small; m; m &= m - 1) {
         int i = __builtin_ctz(m);
-        uint64_t key = (uint64_t)zk[i] << 32 | (x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i);
+        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, pid, i);
         uint64_t *c = grid + c0[i];
         cell_min(c, key);
         cell_min(c + da[i], key);
@@ -235,7 +242,7 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
     }
     for (uint32_t m = large; m; m &= m - 1) {
         int i = __builtin_ctz(m);
-        uint64_t key = (uint64_t)zk[i] << 32 | (x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i);
+        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, pid, i);
         for (int b = box[2][i]; b <= box[3][i]; b++)
             for (int a = box[0][i]; a <= box[1][i]; a++)
                 cell_min(grid + b * g + a, key);
@@ -243,8 +250,62 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
     return small | large;
 }
 
+/* The filter of a ray with planes (see mask_ray): a lane is hidden when
+ * its cell's front occluder lies nearer by more than its footprint (the
+ * distance taken at the top of the 5 bits the plane replaced) and the
+ * lane lies beyond that one's plane by more than its footprint. */
+static uint32_t filter_planes(const mask_ray *x, uint32_t first, uint32_t mask)
+{
+    const cdl_skd *t = x->ft;
+    const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = x->fpw + first;
+    int cell[16];
+    int32_t zb[16];
+    cells16(x, first, cell, zb);
+#if defined(__AVX512F__)
+    const __m512i c = _mm512_loadu_si512(cell), low = _mm512_set1_epi32(MASK_PLANES - 1);
+    const __mmask16 in = _mm512_mask_cmpge_epi32_mask((__mmask16)mask, c, _mm512_setzero_si512());
+    /* the filled cells from the bits in two registers: no gather where none is */
+    const __m512i w = _mm512_permutex2var_epi32(_mm512_loadu_si512(x->occ), _mm512_srli_epi32(c, 5),
+                                                _mm512_loadu_si512(x->occ + 16));
+    const __mmask16 oc =
+        _mm512_mask_test_epi32_mask(in, _mm512_srlv_epi32(w, _mm512_and_si512(c, _mm512_set1_epi32(31))), _mm512_set1_epi32(1));
+    if (!oc)
+        return mask;
+    const __m512i v = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(INT32_MAX), oc, c, (const int *)x->cz, 4);
+    const __mmask16 cm = _mm512_mask_cmplt_epi32_mask(oc, _mm512_or_si512(v, low), _mm512_loadu_si512(zb));
+    if (!cm)
+        return mask;
+    const __m512i k = _mm512_and_si512(v, low);
+    const float *T = x->tab;
+    const __m512 nx = _mm512_permutex2var_ps(_mm512_loadu_ps(T), k, _mm512_loadu_ps(T + 16));
+    const __m512 ny = _mm512_permutex2var_ps(_mm512_loadu_ps(T + 32), k, _mm512_loadu_ps(T + 48));
+    const __m512 nz = _mm512_permutex2var_ps(_mm512_loadu_ps(T + 64), k, _mm512_loadu_ps(T + 80));
+    const __m512 d = _mm512_permutex2var_ps(_mm512_loadu_ps(T + 96), k, _mm512_loadu_ps(T + 112));
+    const __m512 sy = _mm512_fmadd_ps(_mm512_loadu_ps(pz), nz,
+                                      _mm512_fmadd_ps(_mm512_loadu_ps(py), ny, _mm512_fmsub_ps(_mm512_loadu_ps(px), nx, d)));
+    return mask & ~(uint32_t)_mm512_mask_cmp_ps_mask(cm, sy, _mm512_loadu_ps(pw), _CMP_GT_OQ);
+#else
+    uint32_t keep = mask;
+    for (uint32_t m = mask; m; m &= m - 1) {
+        int i = __builtin_ctz(m), c = cell[i];
+        if (c < 0 || !(x->occ[c >> 5] >> (c & 31) & 1u))
+            continue;
+        uint32_t v = x->cz[c], k = v & (MASK_PLANES - 1);
+        if ((int32_t)(v | (MASK_PLANES - 1)) >= zb[i])
+            continue;
+        const float *T = x->tab;
+        float sy = px[i] * T[k] + py[i] * T[MASK_PLANES + k] + pz[i] * T[2 * MASK_PLANES + k] - T[3 * MASK_PLANES + k];
+        if (sy > pw[i])
+            keep &= ~(1u << i);
+    }
+    return keep;
+#endif
+}
+
 uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask)
 {
+    if (x->tab)
+        return filter_planes(x, first, mask);
     const cdl_skd *t = x->ft;
     const float ox = x->r->o.x, oy = x->r->o.y, oz = x->r->o.z;
     const float *px = t->p[0] + first, *py = t->p[1] + first, *pz = t->p[2] + first, *pw = x->fpw + first;

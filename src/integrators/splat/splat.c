@@ -556,10 +556,11 @@ static void splat_report(const void *self, cdl_stats *out)
     splat_cache_report(s, out);
     if (s->mask)
         cdl_stats_printf(out, "splat: visibility mask: %.1f %% of the eye samples may hide others, %.1f %% of the "
-               "photon rays met one and got a buffer; %.1f occluders tested and %.1f rasterized per photon ray, "
-               "%.1f %% of the feasible splats masked\n",
+               "photon rays met one and got a buffer (%.1f %% of those with planes); %.1f occluders tested and %.1f "
+               "rasterized per photon ray, %.1f %% of the feasible splats masked\n",
                t->samples ? 100.0 * (double)t->mask_occ / (double)t->samples : 0.0,
                t->rays_stored ? 100.0 * (double)t->mask_buffers / (double)t->rays_stored : 0.0,
+               t->mask_buffers ? 100.0 * (double)t->mask_planar / (double)t->mask_buffers : 0.0,
                t->rays_stored ? (double)t->mask_tested / (double)t->rays_stored : 0.0,
                t->rays_stored ? (double)t->rasterized / (double)t->rays_stored : 0.0,
                t->splats + t->masked ? 100.0 * (double)t->masked / (double)(t->splats + t->masked) : 0.0);

@@ -34,6 +34,7 @@ typedef struct splat_stats {
     uint64_t rays_stored, splats, tested, nodes, samples, passes, segments;
     uint64_t records, cache_passes, ray_refs, mask_tested, masked, rasterized, mask_occ;
     uint64_t mask_buffers; /* photon rays with a visibility mask; mask_occ: occluders over the passes */
+    uint64_t mask_planar;  /* those whose occluders lie on few planes (a plane per cell) */
     uint64_t occluded, occl_rays; /* occlusion: splats dropped, shadow rays traced */
     size_t peak_bytes;
 } splat_stats;
