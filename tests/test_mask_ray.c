@@ -86,26 +86,29 @@ static void planes_match(const cdl_photon_ray *r, const float *const *axp)
         t.p[c] = pos[c], t.nrm[c] = nrm[c], ft.p[c] = fpos[c], ft.nrm[c] = fnrm[c];
     t.n = 16 * NH, ft.n = NF;
     const int g = 32, gg = g * g;
-    uint64_t *gi = malloc(sizeof *gi * gg), *gp = malloc(sizeof *gp * gg);
+    uint64_t *gi = malloc(sizeof *gi * gg);
     uint32_t *zg = malloc(sizeof *zg * gg), *ig = malloc(sizeof *ig * gg), *cz = malloc(sizeof *cz * gg);
     uint32_t occ[MASK_G * MASK_G / 32];
     memset(occ, 0, sizeof occ);
     mask_ray xi = {.t = &t, .r = r, .pw = pw, .ax = axp, .U = {1.0f, 0.0f, 0.0f}, .V = {0.0f, 1.0f, 0.0f},
                    .eps = 1e-5f, .g = g, .reach = INT32_MAX, .grid = gi, .id = fid, .ft = &ft, .fpw = fpw};
     mask_ray xp = xi;
-    xp.grid = gp;
+    xp.grid = NULL;
     for (int c = 0; c < gg; c++)
-        gi[c] = gp[c] = UINT64_MAX;
+        gi[c] = UINT64_MAX, cz[c] = (uint32_t)INT32_MAX;
+    xp.grid32 = cz;
     for (uint32_t b = 0; b < NH; b++) {
-        splat_mask_rasterize_z(&xi, h[b].first, h[b].mask, h[b].z, NULL);
-        splat_mask_rasterize_z(&xp, h[b].first, h[b].mask, h[b].z, h[b].pid);
+        splat_mask_rasterize_z(&xi, h[b].first, h[b].mask, h[b].z);
+        splat_mask_rasterize_planes(&xp, h[b].first, h[b].mask, h[b].z, h[b].pid);
     }
+    int cover = 0;
     for (int c = 0; c < gg; c++) {
-        int full = gi[c] != UINT64_MAX;
+        int full = gi[c] != UINT64_MAX, full32 = cz[c] != (uint32_t)INT32_MAX;
         zg[c] = full ? (uint32_t)(gi[c] >> 32) : (uint32_t)INT32_MAX, ig[c] = (uint32_t)gi[c];
-        cz[c] = full ? ((uint32_t)(gp[c] >> 32) & ~(uint32_t)(MASK_PLANES - 1)) | (uint32_t)gp[c] : (uint32_t)INT32_MAX;
-        occ[c >> 5] |= (uint32_t)full << (c & 31);
+        occ[c >> 5] |= (uint32_t)full32 << (c & 31);
+        cover += full != full32;
     }
+    CHECK(cover == 0, "planes and occluders fill the same cells (%d differ)", cover);
     xi.zg = zg, xi.ig = ig;
     xp.cz = cz, xp.occ = occ, xp.tab = tab;
     uint32_t hidden = 0, differ = 0;
@@ -116,7 +119,7 @@ static void planes_match(const cdl_photon_ray *r, const float *const *axp)
     }
     CHECK(differ == 0 && hidden > NF / 20 && hidden < NF - NF / 20,
           "planes per cell hide what occluders per cell do (%u of %u differ, %u hidden)", differ, NF, hidden);
-    free(gi), free(gp), free(zg), free(ig), free(cz);
+    free(gi), free(zg), free(ig), free(cz);
 }
 
 int main(void)
@@ -156,6 +159,7 @@ int main(void)
             ax[0][q] = s2 * nrm[2][q], ax[1][q] = 0.0f, ax[2][q] = -s2 * nrm[0][q];
             ax[3][q] = 0.0f, ax[4][q] = s * 1.0f, ax[5][q] = 0.0f;
             held[b].z[i] = pos[2][q];
+            held[b].pid[i] = (uint8_t)((b + i) % 5);
         }
     }
     cdl_skd t;
@@ -189,6 +193,25 @@ int main(void)
                   cut ? "cut" : "open", (unsigned long long)n0, (unsigned long long)n1);
             CHECK(diff == 0 && filled > g * g / 2, "g %d, reach %s: the same buffer (%d of %d cells differ, %d filled)",
                   g, cut ? "cut" : "open", diff, g * g, filled);
+            /* the same with a plane per cell (32-bit keys, two rows a
+             * register) */
+            uint32_t *h0 = (uint32_t *)g0, *h1 = (uint32_t *)g1;
+            for (int c = 0; c < MASK_G * MASK_G; c++)
+                h0[c] = h1[c] = (uint32_t)INT32_MAX;
+            x0.grid32 = h0, x1.grid32 = h1;
+            n0 = n1 = 0;
+            for (uint32_t b = 0; b < NB; b++) {
+                n0 += (uint64_t)__builtin_popcount(splat_mask_rasterize_planes(&x0, held[b].first, held[b].mask, held[b].z, held[b].pid));
+                n1 += (uint64_t)__builtin_popcount(splat_mask_rasterize_planes(&x1, held[b].first, held[b].mask, held[b].z, held[b].pid));
+            }
+            diff = filled = 0;
+            for (int c = 0; c < g * g; c++) {
+                diff += h0[c] != h1[c];
+                filled += h0[c] != (uint32_t)INT32_MAX;
+            }
+            CHECK(n0 == n1 && diff == 0 && filled > g * g / 2,
+                  "g %d, reach %s, planes: the same lanes and buffer (%llu, %llu; %d cells differ, %d filled)", g,
+                  cut ? "cut" : "open", (unsigned long long)n0, (unsigned long long)n1, diff, filled);
         }
 
     free(g0);

@@ -454,7 +454,7 @@ static void ray_frame(const splat_state *s, const cdl_photon_ray *r, int g, mask
     float big = fmaxf(m->scale, fmaxf(fabsf(r->o.x), fmaxf(fabsf(r->o.y), fabsf(r->o.z))));
     *x = (mask_ray){&m->occ, r, m->opw, (const float *const *)m->oax, {f.t.x, f.t.y, f.t.z}, {f.b.x, f.b.y, f.b.z},
                     /* ~10x the rounding of a plane offset at the coordinates' scale */
-                    1e-5f * big, g, INT32_MAX, NULL, 0, m->oid, m->oside,
+                    1e-5f * big, g, INT32_MAX, NULL, NULL, 0, m->oid, m->oside,
                     &s->tree, m->pw, NULL, NULL, NULL, NULL, NULL};
 }
 
@@ -686,43 +686,35 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
         x->oom = 1;
         return;
     }
-    uint64_t *grid = x->grid;
-    memset(grid, 0xff, sizeof *grid * gg);
-    x->x.grid = grid;
-    for (uint32_t b = 0; b < x->nh; b++)
-        x->rasterized += (uint64_t)__builtin_popcount(splat_mask_rasterize_z(
-            &x->x, x->held[b].first, x->held[b].mask, x->held[b].z, planes ? x->held[b].pid : NULL));
     uint32_t *out = x->cells[sl] + x->ncell[sl];
     if (planes) {
         /* the filled cells' bits, the planes, and per cell its front
-         * occluder's distance bits with its plane in the low bits */
+         * occluder's distance bits with its plane in the low bits,
+         * rasterized in place */
         uint32_t *occ = out, *cz = out + MASK_OCC + 4 * MASK_PLANES;
-        memset(occ, 0, sizeof *occ * MASK_OCC);
         memcpy(out + MASK_OCC, x->tab, sizeof x->tab);
+        for (uint32_t c = 0; c < gg; c++)
+            cz[c] = (uint32_t)INT32_MAX;
+        x->x.grid32 = cz;
+        for (uint32_t b = 0; b < x->nh; b++)
+            x->rasterized += (uint64_t)__builtin_popcount(
+                splat_mask_rasterize_planes(&x->x, x->held[b].first, x->held[b].mask, x->held[b].z, x->held[b].pid));
+        memset(occ, 0, sizeof *occ * MASK_OCC);
         uint32_t c = 0;
 #if defined(__AVX512F__)
-        const __m512i hi = _mm512_set1_epi64((long long)(~(unsigned long long)(MASK_PLANES - 1) << 32)), none = _mm512_set1_epi64(-1);
-        for (; c < gg; c += 16) {
-            const __mmask16 k = (__mmask16)(gg - c >= 16 ? 0xffffu : (1u << (gg - c)) - 1u);
-            const __m512i a = _mm512_maskz_loadu_epi64((__mmask8)k, grid + c);
-            const __m512i b = _mm512_maskz_loadu_epi64((__mmask8)(k >> 8), grid + c + 8);
-            const __mmask16 full = (__mmask16)(_mm512_mask_cmpneq_epi64_mask((__mmask8)k, a, none) |
-                                               _mm512_mask_cmpneq_epi64_mask((__mmask8)(k >> 8), b, none) << 8);
-            /* distance bits over the plane: (key & hi) | low word, folded to 32 bits */
-            const __m256i ca = _mm512_cvtepi64_epi32(_mm512_or_si512(_mm512_srli_epi64(_mm512_and_si512(a, hi), 32), a));
-            const __m256i cb = _mm512_cvtepi64_epi32(_mm512_or_si512(_mm512_srli_epi64(_mm512_and_si512(b, hi), 32), b));
-            const __m512i v = _mm512_inserti64x4(_mm512_castsi256_si512(ca), cb, 1);
-            _mm512_mask_storeu_epi32(cz + c, k, _mm512_mask_mov_epi32(_mm512_set1_epi32(INT32_MAX), full, v));
-            occ[c >> 5] |= (uint32_t)full << (c & 31);
-        }
+        for (; c + 16 <= gg; c += 16)
+            occ[c >> 5] |= (uint32_t)_mm512_cmpneq_epi32_mask(_mm512_loadu_si512(cz + c), _mm512_set1_epi32(INT32_MAX))
+                           << (c & 31);
 #endif
-        for (; c < gg; c++) {
-            const int full = grid[c] != UINT64_MAX;
-            cz[c] = full ? ((uint32_t)(grid[c] >> 32) & ~(uint32_t)(MASK_PLANES - 1)) | (uint32_t)grid[c]
-                         : (uint32_t)INT32_MAX;
-            occ[c >> 5] |= (uint32_t)full << (c & 31);
-        }
+        for (; c < gg; c++)
+            occ[c >> 5] |= (uint32_t)(cz[c] != (uint32_t)INT32_MAX) << (c & 31);
     } else {
+        uint64_t *grid = x->grid;
+        memset(grid, 0xff, sizeof *grid * gg);
+        x->x.grid = grid;
+        for (uint32_t b = 0; b < x->nh; b++)
+            x->rasterized += (uint64_t)__builtin_popcount(
+                splat_mask_rasterize_z(&x->x, x->held[b].first, x->held[b].mask, x->held[b].z));
         /* split for the filter: one gather of distances, one of samples
          * where they are near enough */
         uint32_t *zg = out, *ig = zg + gg;

@@ -51,6 +51,32 @@ static inline void cells16(const mask_ray *x, uint32_t first, int *cell, int32_t
  * from the stores of the lanes before, which hit the same cells). */
 static inline void cell_min(uint64_t *c, uint64_t key) { *c = key < *c ? key : *c; }
 
+/* The lanes of [first, first + 16) in `lanes` that get rasterized, with
+ * their keys' distance bits zk (+ 0: -0 becomes +0, whose bits order with
+ * the rest), the cells they cover (box: columns a0, a1 and rows b0, b1,
+ * inclusive; c0, da, db: a box of at most 2 x 2 cells as its corners) and
+ * small / large: the lanes whose box is at most 2 x 2 cells or larger. */
+typedef struct lane_cells {
+    uint32_t zk[16];
+    int box[4][16], c0[16], da[16], db[16];
+    uint32_t small, large;
+} lane_cells;
+
+#if defined(__AVX512F__)
+/* Per lane, its columns of the window from A0 (8 bits) and its rows from
+ * B0 (bits). */
+static inline void window_bits(const lane_cells *L, int A0, int B0, __m512i *cols, __m512i *rows)
+{
+    const __m512i one = _mm512_set1_epi32(1), two = _mm512_set1_epi32(2);
+    const __m512i a0 = _mm512_loadu_si512(L->box[0]), a1 = _mm512_loadu_si512(L->box[1]);
+    const __m512i b0 = _mm512_loadu_si512(L->box[2]), b1 = _mm512_loadu_si512(L->box[3]);
+    *cols = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(a1, a0)), one),
+                              _mm512_sub_epi32(a0, _mm512_set1_epi32(A0)));
+    *rows = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(b1, b0)), one),
+                              _mm512_sub_epi32(b0, _mm512_set1_epi32(B0)));
+}
+#endif
+
 #if defined(__AVX512F__)
 /* The batch's boxes when they lie within 8 columns from A0 and R rows
  * from B0 (R = 2, 4 or 8, a constant: the loops unroll): the window's
@@ -58,28 +84,21 @@ static inline void cell_min(uint64_t *c, uint64_t key) { *c = key < *c ? key : *
  * masked min per row (its columns in the rows it covers), then one
  * update of the grid per row. Scalar updates of the grid each load what
  * the one before stored: a chain of store forwards. */
-static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, const int (*box)[16], const uint32_t *zk,
-                           const uint8_t *pid, int A0, int B0, int B1, const int R)
+static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, const lane_cells *L, int A0, int B0,
+                           int B1, const int R)
 {
-    const __m512i one = _mm512_set1_epi32(1), two = _mm512_set1_epi32(2);
-    const __m512i a0 = _mm512_loadu_si512(box[0]), a1 = _mm512_loadu_si512(box[1]);
-    const __m512i b0 = _mm512_loadu_si512(box[2]), b1 = _mm512_loadu_si512(box[3]);
-    /* per lane its columns and rows in the window, as bits */
-    const __m512i cols = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(a1, a0)), one),
-                                           _mm512_sub_epi32(a0, _mm512_set1_epi32(A0)));
-    const __m512i rows = _mm512_sllv_epi32(_mm512_sub_epi32(_mm512_sllv_epi32(two, _mm512_sub_epi32(b1, b0)), one),
-                                           _mm512_sub_epi32(b0, _mm512_set1_epi32(B0)));
+    __m512i cols, rows;
+    window_bits(L, A0, B0, &cols, &rows);
     uint8_t km[8][16];
     for (int r = 0; r < R; r++) {
         __mmask16 in = _mm512_test_epi32_mask(rows, _mm512_set1_epi32(1 << r));
         _mm_storeu_si128((__m128i *)km[r], _mm512_cvtepi32_epi8(_mm512_maskz_mov_epi32(in, cols)));
     }
     uint64_t key[16];
-    const __m512i z = _mm512_loadu_si512(zk);
-    const __m512i idx = pid    ? _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)pid))
-                        : x->id ? _mm512_loadu_si512(x->id + first)
-                                : _mm512_add_epi32(_mm512_set1_epi32((int)first),
-                                                   _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+    const __m512i z = _mm512_loadu_si512(L->zk);
+    const __m512i idx = x->id ? _mm512_loadu_si512(x->id + first)
+                              : _mm512_add_epi32(_mm512_set1_epi32((int)first),
+                                                 _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
     _mm512_storeu_si512(key, _mm512_or_si512(_mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_castsi512_si256(z)), 32),
                                              _mm512_cvtepu32_epi64(_mm512_castsi512_si256(idx))));
     _mm512_storeu_si512(key + 8,
@@ -117,33 +136,31 @@ static inline void window8(const mask_ray *x, uint32_t first, uint32_t live, con
 
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb)
 {
-    return (uint32_t)__builtin_popcount(splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z, NULL));
+    return (uint32_t)__builtin_popcount(splat_mask_rasterize_z(x, hb->first, hb->mask, hb->z));
 }
 
-/* The low word of lane i's key: its plane, or its index. */
-static inline uint32_t key_lo(const mask_ray *x, uint32_t first, const uint8_t *pid, int i)
+/* The low word of lane i's key: its index. */
+static inline uint32_t key_lo(const mask_ray *x, uint32_t first, int i)
 {
-    return pid ? pid[i] : x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i;
+    return x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i;
 }
 
-uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, const uint8_t *pid)
+static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, lane_cells *L)
 {
     const cdl_skd *t = x->t;
     const cdl_photon_ray *r = x->r;
     const float *U = x->U, *V = x->V;
     const int g = x->g;
-    uint64_t *grid = x->grid;
-    /* lanes nearer than the reach, as their key's distance bits (+ 0: -0
-     * becomes +0, whose bits order with the rest) */
-    uint32_t zk[16], near = 0;
+    /* lanes nearer than the reach */
+    uint32_t near = 0;
 #if defined(__AVX512F__)
     __m512i zb = _mm512_castps_si512(_mm512_add_ps(_mm512_loadu_ps(zz), _mm512_setzero_ps()));
     near = _mm512_mask_cmplt_epi32_mask((__mmask16)lanes, zb, _mm512_set1_epi32(x->reach));
-    _mm512_storeu_si512(zk, zb);
+    _mm512_storeu_si512(L->zk, zb);
 #else
     for (int i = 0; i < 16; i++) {
-        zk[i] = float_bits(zz[i] + 0.0f);
-        near |= (uint32_t)((int32_t)zk[i] < x->reach) << i;
+        L->zk[i] = float_bits(zz[i] + 0.0f);
+        near |= (uint32_t)((int32_t)L->zk[i] < x->reach) << i;
     }
     near &= lanes;
 #endif
@@ -159,10 +176,11 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
         ax[c] = x->ax[c] + first;
     /* the sides of its plane an origin may lie on for a sample to hide
      * anything (bit 0 in front, bit 1 behind); all without x->side */
-    int side[16];
+    int side[16], kind[16];
     for (int i = 0; i < 16; i++)
         side[i] = x->side ? x->side[first + (uint32_t)i] : 3;
-    int box[4][16], c0[16], da[16], db[16], kind[16];
+    int(*box)[16] = L->box;
+    int *c0 = L->c0, *da = L->da, *db = L->db;
     /* the cells each lane covers, 16 at a time (lanes past m are masked) */
 #pragma omp simd
     for (int i = 0; i < 16; i++) {
@@ -201,53 +219,171 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
         small |= (uint32_t)(kind[i] == 1) << i;
         large |= (uint32_t)(kind[i] == 2) << i;
     }
-    small &= near, large &= near;
+    L->small = small & near, L->large = large & near;
+    return L->small | L->large;
+}
+
 #if defined(__AVX512F__)
-    const uint32_t live = small | large;
-    if (live && !x->plain) {
-        /* the live boxes' extremes in one reduction: a lane's a0, b0,
-         * 255 - a1 and 255 - b1 (all in [0, g)) as its bytes, their minima */
-        const __m512i ff = _mm512_set1_epi32(255);
-        __m512i pk = _mm512_or_si512(
-            _mm512_or_si512(_mm512_loadu_si512(box[0]), _mm512_slli_epi32(_mm512_loadu_si512(box[2]), 8)),
-            _mm512_or_si512(_mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[1])), 16),
-                            _mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(box[3])), 24)));
-        pk = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), (__mmask16)live, pk);
-        __m256i h = _mm256_min_epu8(_mm512_castsi512_si256(pk), _mm512_extracti64x4_epi64(pk, 1));
-        __m128i q = _mm_min_epu8(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
-        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0x4e));
-        q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0xb1));
-        const uint32_t e = (uint32_t)_mm_cvtsi128_si32(q);
-        const int A0 = (int)(e & 255u), B0 = (int)(e >> 8 & 255u);
-        const int A1 = 255 - (int)(e >> 16 & 255u), B1 = 255 - (int)(e >> 24);
-        if (A1 - A0 < 8 && B1 - B0 < 8) {
-            if (B1 - B0 < 2)
-                window8(x, first, live, box, zk, pid, A0, B0, B1, 2);
-            else if (B1 - B0 < 4)
-                window8(x, first, live, box, zk, pid, A0, B0, B1, 4);
-            else
-                window8(x, first, live, box, zk, pid, A0, B0, B1, 8);
-            return live;
-        }
+/* Whether the live lanes' boxes fit a window of 8 x 8 cells: its first
+ * column and rows from B0 to B1. */
+static inline int window_of(const lane_cells *L, uint32_t live, int *A0, int *B0, int *B1)
+{
+    /* the live boxes' extremes in one reduction: a lane's a0, b0, 255 - a1
+     * and 255 - b1 (all in [0, g)) as its bytes, their minima */
+    const __m512i ff = _mm512_set1_epi32(255);
+    __m512i pk = _mm512_or_si512(
+        _mm512_or_si512(_mm512_loadu_si512(L->box[0]), _mm512_slli_epi32(_mm512_loadu_si512(L->box[2]), 8)),
+        _mm512_or_si512(_mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(L->box[1])), 16),
+                        _mm512_slli_epi32(_mm512_sub_epi32(ff, _mm512_loadu_si512(L->box[3])), 24)));
+    pk = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), (__mmask16)live, pk);
+    __m256i h = _mm256_min_epu8(_mm512_castsi512_si256(pk), _mm512_extracti64x4_epi64(pk, 1));
+    __m128i q = _mm_min_epu8(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+    q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0x4e));
+    q = _mm_min_epu8(q, _mm_shuffle_epi32(q, 0xb1));
+    const uint32_t e = (uint32_t)_mm_cvtsi128_si32(q);
+    *A0 = (int)(e & 255u), *B0 = (int)(e >> 8 & 255u), *B1 = 255 - (int)(e >> 24);
+    return 255 - (int)(e >> 16 & 255u) - *A0 < 8 && *B1 - *B0 < 8;
+}
+
+#endif
+
+uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz)
+{
+    const int g = x->g;
+    uint64_t *grid = x->grid;
+    lane_cells L;
+    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L);
+    if (!live)
+        return 0;
+    const uint32_t *zk = L.zk;
+#if defined(__AVX512F__)
+    int A0, B0, B1;
+    if (!x->plain && window_of(&L, live, &A0, &B0, &B1)) {
+        if (B1 - B0 < 2)
+            window8(x, first, live, &L, A0, B0, B1, 2);
+        else if (B1 - B0 < 4)
+            window8(x, first, live, &L, A0, B0, B1, 4);
+        else
+            window8(x, first, live, &L, A0, B0, B1, 8);
+        return live;
     }
 #endif
-    for (uint32_t m = small; m; m &= m - 1) {
+    for (uint32_t m = L.small; m; m &= m - 1) {
         int i = __builtin_ctz(m);
-        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, pid, i);
-        uint64_t *c = grid + c0[i];
+        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, i);
+        uint64_t *c = grid + L.c0[i];
         cell_min(c, key);
-        cell_min(c + da[i], key);
-        cell_min(c + db[i], key);
-        cell_min(c + db[i] + da[i], key);
+        cell_min(c + L.da[i], key);
+        cell_min(c + L.db[i], key);
+        cell_min(c + L.db[i] + L.da[i], key);
     }
-    for (uint32_t m = large; m; m &= m - 1) {
+    for (uint32_t m = L.large; m; m &= m - 1) {
         int i = __builtin_ctz(m);
-        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, pid, i);
-        for (int b = box[2][i]; b <= box[3][i]; b++)
-            for (int a = box[0][i]; a <= box[1][i]; a++)
+        uint64_t key = (uint64_t)zk[i] << 32 | key_lo(x, first, i);
+        for (int b = L.box[2][i]; b <= L.box[3][i]; b++)
+            for (int a = L.box[0][i]; a <= L.box[1][i]; a++)
                 cell_min(grid + b * g + a, key);
     }
-    return small | large;
+    return live;
+}
+
+static inline void cell_min32(uint32_t *c, uint32_t key) { *c = key < *c ? key : *c; }
+
+#if defined(__AVX512F__)
+/* window8 for 32-bit keys: a register holds two rows of the window (8
+ * columns each), so RP registers hold 2 RP rows. */
+static inline void window16(const mask_ray *x, uint32_t live, const lane_cells *L, const uint32_t *key, int A0, int B0,
+                            int B1, const int RP)
+{
+    __m512i cols, rows;
+    window_bits(L, A0, B0, &cols, &rows);
+    /* per lane and register its cells: columns of the even row, then of
+     * the odd one 8 bits up */
+    uint16_t km[4][16];
+    for (int j = 0; j < RP; j++) {
+        const __mmask16 e = _mm512_test_epi32_mask(rows, _mm512_set1_epi32(1 << 2 * j));
+        const __mmask16 o = _mm512_test_epi32_mask(rows, _mm512_set1_epi32(2 << 2 * j));
+        const __m512i m = _mm512_or_si512(_mm512_maskz_mov_epi32(e, cols), _mm512_maskz_slli_epi32(o, cols, 8));
+        _mm256_storeu_si256((__m256i *)km[j], _mm512_cvtepi32_epi16(m));
+    }
+    __m512i acc[4], alt[4];
+    for (int j = 0; j < RP; j++)
+        acc[j] = alt[j] = _mm512_set1_epi32(-1);
+    uint32_t m = live;
+    for (; m & (m - 1); m &= m - 1) {
+        int i = __builtin_ctz(m);
+        m &= m - 1;
+        int k = __builtin_ctz(m);
+        const __m512i a = _mm512_set1_epi32((int)key[i]), b = _mm512_set1_epi32((int)key[k]);
+        for (int j = 0; j < RP; j++) {
+            acc[j] = _mm512_mask_min_epu32(acc[j], km[j][i], acc[j], a);
+            alt[j] = _mm512_mask_min_epu32(alt[j], km[j][k], alt[j], b);
+        }
+    }
+    if (m) {
+        int i = __builtin_ctz(m);
+        const __m512i a = _mm512_set1_epi32((int)key[i]);
+        for (int j = 0; j < RP; j++)
+            acc[j] = _mm512_mask_min_epu32(acc[j], km[j][i], acc[j], a);
+    }
+    const int g = x->g;
+    const __mmask8 in = (__mmask8)(g - A0 >= 8 ? 0xffu : (1u << (g - A0)) - 1u);
+    for (int j = 0; j < RP; j++) {
+        const __m512i v = _mm512_min_epu32(acc[j], alt[j]);
+        const int r = B0 + 2 * j;
+        if (r <= B1) {
+            uint32_t *c = x->grid32 + (ptrdiff_t)r * g + A0;
+            _mm256_mask_storeu_epi32(c, in, _mm256_min_epu32(_mm256_maskz_loadu_epi32(in, c), _mm512_castsi512_si256(v)));
+        }
+        if (r + 1 <= B1) {
+            uint32_t *c = x->grid32 + (ptrdiff_t)(r + 1) * g + A0;
+            _mm256_mask_storeu_epi32(c, in,
+                                     _mm256_min_epu32(_mm256_maskz_loadu_epi32(in, c), _mm512_extracti64x4_epi64(v, 1)));
+        }
+    }
+}
+#endif
+
+uint32_t splat_mask_rasterize_planes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz,
+                                     const uint8_t *pid)
+{
+    const int g = x->g;
+    uint32_t *grid = x->grid32;
+    lane_cells L;
+    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L);
+    if (!live)
+        return 0;
+    /* the keys: distance bits over the plane in the low bits */
+    uint32_t key[16];
+    for (int i = 0; i < 16; i++)
+        key[i] = (L.zk[i] & ~(uint32_t)(MASK_PLANES - 1)) | pid[i];
+#if defined(__AVX512F__)
+    int A0, B0, B1;
+    if (!x->plain && window_of(&L, live, &A0, &B0, &B1)) {
+        if (B1 - B0 < 2)
+            window16(x, live, &L, key, A0, B0, B1, 1);
+        else if (B1 - B0 < 4)
+            window16(x, live, &L, key, A0, B0, B1, 2);
+        else
+            window16(x, live, &L, key, A0, B0, B1, 4);
+        return live;
+    }
+#endif
+    for (uint32_t m = L.small; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        uint32_t *c = grid + L.c0[i];
+        cell_min32(c, key[i]);
+        cell_min32(c + L.da[i], key[i]);
+        cell_min32(c + L.db[i], key[i]);
+        cell_min32(c + L.db[i] + L.da[i], key[i]);
+    }
+    for (uint32_t m = L.large; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        for (int b = L.box[2][i]; b <= L.box[3][i]; b++)
+            for (int a = L.box[0][i]; a <= L.box[1][i]; a++)
+                cell_min32(grid + b * g + a, key[i]);
+    }
+    return live;
 }
 
 /* The filter of a ray with planes (see mask_ray): a lane is hidden when

@@ -29,6 +29,7 @@ typedef struct mask_ray {
     int32_t reach;               /* the largest z - pw of a feasible sample, as bits: no sample
                                   * as far along the ray can hide one */
     uint64_t *grid;              /* g x g cells: distance bits << 32 | sample; UINT64_MAX empty */
+    uint32_t *grid32;            /* or, with planes, as cz below */
     int plain;                   /* rasterize one cell at a time (tests: the windows' reference) */
     const uint32_t *id;          /* per occluder its index in ft (the keys'), NULL: the same */
     const uint8_t *side;         /* per occluder the sides an origin may hide from (bit 0 in front of its
@@ -47,10 +48,14 @@ typedef struct mask_ray {
 
 /* One held batch into x->grid; returns the samples it rasterized. */
 uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb);
-/* The same for occluders [first, first + 16) in lanes with distances z,
- * each cell keeping the front one's plane pid[lane] (or, pid NULL, its
- * index); returns the lanes it rasterized. */
-uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z, const uint8_t *pid);
+/* The same for occluders [first, first + 16) in lanes with distances z;
+ * returns the lanes it rasterized. */
+uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z);
+/* The same into x->grid32, each cell keeping the front one's distance
+ * bits with its plane pid[lane] in the low bits (the cz a filter with
+ * planes reads; empty cells INT32_MAX). */
+uint32_t splat_mask_rasterize_planes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z,
+                                     const uint8_t *pid);
 /* The lanes in mask of feasible samples [first, first + 16) the buffer
  * does not hide. */
 uint32_t splat_mask_filter(const mask_ray *x, uint32_t first, uint32_t mask);
