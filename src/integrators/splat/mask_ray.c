@@ -145,7 +145,11 @@ static inline uint32_t key_lo(const mask_ray *x, uint32_t first, int i)
     return x->id ? x->id[first + (uint32_t)i] : first + (uint32_t)i;
 }
 
-static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, lane_cells *L)
+/* sides: whether to drop the lanes whose plane holds the origin or that
+ * hide nothing from its side (else the caller's lanes are such already:
+ * collect's) */
+static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, lane_cells *L,
+                                      const int sides)
 {
     const cdl_skd *t = x->t;
     const cdl_photon_ray *r = x->r;
@@ -177,7 +181,7 @@ static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_
     /* the sides of its plane an origin may lie on for a sample to hide
      * anything (bit 0 in front, bit 1 behind); all without x->side */
     int side[16], kind[16];
-    for (int i = 0; i < 16; i++)
+    for (int i = 0; sides && i < 16; i++)
         side[i] = x->side ? x->side[first + (uint32_t)i] : 3;
     int(*box)[16] = L->box;
     int *c0 = L->c0, *da = L->da, *db = L->db;
@@ -190,7 +194,7 @@ static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_
          * around the ray it would stand in front of what does */
         float so = Dx * nx[i] + Dy * ny[i] + Dz * nz[i];
         /* (so > 0: the origin lies behind the plane) */
-        int keep = (fabsf(so) > pw[i]) & ((so > 0.0f ? side[i] >> 1 : side[i]) & 1);
+        int keep = !sides || ((fabsf(so) > pw[i]) & ((so > 0.0f ? side[i] >> 1 : side[i]) & 1));
         /* in the kernel's plane: lateral offsets over the radius at z */
         float ih = ics / (h0 + dh * (z < len ? z : len));
         float u = (ex * U[0] + ey * U[1] + ez * U[2]) * ih + 0.5f * (float)g;
@@ -252,7 +256,7 @@ uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lane
     const int g = x->g;
     uint64_t *grid = x->grid;
     lane_cells L;
-    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L);
+    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L, 1);
     if (!live)
         return 0;
     const uint32_t *zk = L.zk;
@@ -350,7 +354,7 @@ uint32_t splat_mask_rasterize_planes(const mask_ray *x, uint32_t first, uint32_t
     const int g = x->g;
     uint32_t *grid = x->grid32;
     lane_cells L;
-    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L);
+    const uint32_t live = cells_of_lanes(x, first, lanes, zz, &L, 0);
     if (!live)
         return 0;
     /* the keys: distance bits over the plane in the low bits */

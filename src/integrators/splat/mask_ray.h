@@ -53,7 +53,8 @@ uint32_t splat_mask_rasterize(const mask_ray *x, const mask_held *hb);
 uint32_t splat_mask_rasterize_z(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z);
 /* The same into x->grid32, each cell keeping the front one's distance
  * bits with its plane pid[lane] in the low bits (the cz a filter with
- * planes reads; empty cells INT32_MAX). */
+ * planes reads; empty cells INT32_MAX), for lanes that may hide something
+ * (collect's: not tested again). */
 uint32_t splat_mask_rasterize_planes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *z,
                                      const uint8_t *pid);
 /* The lanes in mask of feasible samples [first, first + 16) the buffer
