@@ -148,6 +148,9 @@ static inline uint32_t key_lo(const mask_ray *x, uint32_t first, int i)
 /* sides: whether to drop the lanes whose plane holds the origin or that
  * hide nothing from its side (else the caller's lanes are such already:
  * collect's) */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
 static inline uint32_t cells_of_lanes(const mask_ray *x, uint32_t first, uint32_t lanes, const float *zz, lane_cells *L,
                                       const int sides)
 {
