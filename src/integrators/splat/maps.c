@@ -521,8 +521,8 @@ int splat_maps_splat(splat_state *s)
      * of parts build the next one's buffers (the occluders in each
      * frustum) */
     const uint32_t batch = s->mask ? SPLAT_MASK_BATCH : (n ? n : 1), nb = (n + batch - 1) / batch;
-    splat_sums sum = {0, 0, 0, 0, 0, 0};
-#pragma omp parallel
+    uint64_t splats = 0, tested = 0, nodes = 0, occluded = 0, occl_rays = 0, masked = 0;
+#pragma omp parallel reduction(+ : splats, tested, nodes, occluded, occl_rays, masked)
     {
         splat_sums mine = {0, 0, 0, 0, 0, 0};
         if (s->mask) {
@@ -547,22 +547,19 @@ int splat_maps_splat(splat_state *s)
             if (s->mask)
                 splat_mask_recycle(s, k0);
         }
-#pragma omp critical(splat_sums)
-        {
-            sum.splats += mine.splats, sum.tested += mine.tested, sum.nodes += mine.nodes;
-            sum.occluded += mine.occluded, sum.occl_rays += mine.occl_rays, sum.masked += mine.masked;
-        }
+        splats += mine.splats, tested += mine.tested, nodes += mine.nodes;
+        occluded += mine.occluded, occl_rays += mine.occl_rays, masked += mine.masked;
     }
     free(order);
     free(reach);
     if (s->mask && splat_mask_end(s))
         return CDL_ERR_SYSTEM;
-    s->st.splats += sum.splats;
-    s->st.occluded += sum.occluded;
-    s->st.masked += sum.masked;
-    s->st.occl_rays += sum.occl_rays;
-    s->st.tested += sum.tested;
-    s->st.nodes += sum.nodes;
+    s->st.splats += splats;
+    s->st.occluded += occluded;
+    s->st.masked += masked;
+    s->st.occl_rays += occl_rays;
+    s->st.tested += tested;
+    s->st.nodes += nodes;
     return 0;
 }
 
