@@ -80,6 +80,7 @@ typedef struct mask_worker {
      * many normals to ask) */
     cdl_skd_plane pl[PLANES];
     int np, last; /* last: the plane the last lane had */
+    float cmax[16]; /* lanes of offsets on plane last not yet in its c (-inf: none) */
     /* the occluders' distinct planes (MASK_PLANES + 1: too many), as
      * mask_ray's tab, and the one the last lane had */
     float tab[4 * MASK_PLANES];
@@ -402,6 +403,19 @@ static void plane_ids(mask_worker *x, mask_held *h)
 #endif
 }
 
+/* The offsets collect kept in lanes for the last plane, into its c. */
+static void planes_flush(mask_worker *x)
+{
+#if defined(__AVX512F__)
+    const float c = _mm512_reduce_max_ps(_mm512_loadu_ps(x->cmax)) + x->x.eps;
+    if (x->last < x->np && c > x->pl[x->last].c)
+        x->pl[x->last].c = c;
+    _mm512_storeu_ps(x->cmax, _mm512_set1_ps(-INFINITY));
+#else
+    (void)x;
+#endif
+}
+
 /* The occluders' tree hands the frustum's batches: the lanes that may
  * hide something for this ray (not on the surface it leaves, on a side
  * its origin may hide from) are held, and their planes noted. */
@@ -463,6 +477,23 @@ static void collect(void *ctx, uint32_t first, uint32_t mlen, uint32_t any, cons
 #endif
     /* the planes, turned to the side that hides (the origin's other
      * side): a batch's lanes mostly share one, taken all at once */
+#if defined(__AVX512F__)
+    if (x->last < x->np && x->np <= PLANES) {
+        /* all on the last batch's plane: their offsets' maximum kept in
+         * lanes (reduced when the plane changes or the walk ends) */
+        const cdl_skd_plane *P = &x->pl[x->last];
+        const __m512 zero = _mm512_setzero_ps();
+        __mmask16 on = _mm512_mask_cmp_ps_mask((__mmask16)keep, _mm512_mask_sub_ps(vnx, pos, zero, vnx),
+                                               _mm512_set1_ps(P->n[0]), _CMP_EQ_OQ);
+        on = _mm512_mask_cmp_ps_mask(on, _mm512_mask_sub_ps(vny, pos, zero, vny), _mm512_set1_ps(P->n[1]), _CMP_EQ_OQ);
+        on = _mm512_mask_cmp_ps_mask(on, _mm512_mask_sub_ps(vnz, pos, zero, vnz), _mm512_set1_ps(P->n[2]), _CMP_EQ_OQ);
+        if (on == (__mmask16)keep) {
+            _mm512_storeu_ps(x->cmax, _mm512_mask_max_ps(_mm512_loadu_ps(x->cmax), on, _mm512_loadu_ps(x->cmax), cc));
+            return;
+        }
+    }
+#endif
+    planes_flush(x);
     for (uint32_t m = keep; m && x->np <= PLANES;) {
         uint32_t i = (uint32_t)__builtin_ctz(m);
         const float n0x = nx[i], n0y = ny[i], n0z = nz[i];
@@ -522,9 +553,12 @@ static void build_ray(splat_state *s, uint32_t wid, uint32_t k)
     x->np = 0;
     x->last = 0;
     x->ntab = x->tlast = 0;
+    for (int i = 0; i < 16; i++)
+        x->cmax[i] = -INFINITY;
     cdl_splat_ray sr = splat_ray_of(s, r);
     cdl_skd_count cnt = {0, 0, 0};
     cdl_skd_splat_visit_both(&m->occ, &sr, CDL_SKD_ANY, collect, x, &cnt);
+    planes_flush(x);
     if (!x->nh || x->oom ||
         (x->np <= PLANES && !cdl_skd_any_behind(&s->tree, &sr, s->opt.splat.cull ? CDL_SKD_CULL : 0, x->pl, x->np, m->pw, &cnt)))
         return;
